@@ -1,0 +1,1 @@
+# learning sources (filled by the learning area)

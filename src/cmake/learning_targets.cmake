@@ -1,0 +1,1 @@
+# learning targets (filled by the learning area)

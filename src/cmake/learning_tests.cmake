@@ -1,0 +1,1 @@
+# learning tests (filled by the learning area)

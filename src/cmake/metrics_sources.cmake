@@ -1,0 +1,1 @@
+# metrics sources (filled by the metrics area)

@@ -1,0 +1,1 @@
+# metrics targets (filled by the metrics area)

@@ -1,0 +1,1 @@
+# metrics tests (filled by the metrics area)

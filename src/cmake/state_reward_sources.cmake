@@ -1,0 +1,1 @@
+# state_reward sources (filled by the state_reward area)

@@ -1,0 +1,1 @@
+# state_reward targets (filled by the state_reward area)

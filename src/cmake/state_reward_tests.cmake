@@ -1,0 +1,1 @@
+# state_reward tests (filled by the state_reward area)

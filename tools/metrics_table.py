@@ -1,0 +1,43 @@
+#!/usr/bin/env python3
+"""Print the metric table of one or more metrics.json files side by side."""
+import json
+import pathlib
+import sys
+
+ROWS = [
+    ("efficiency_all_mps", "Efficiency, all vehicles (m/s)", "{:.2f}"),
+    ("efficiency_cav_mps", "Efficiency, CAVs (m/s)", "{:.2f}"),
+    ("collision_rate_pct", "CR (% of CAVs)", "{:.2f}"),
+    ("dsr_pct", "DSR (% of exiting CAVs)", "{:.2f}"),
+    ("msr_pct", "MSR (% of merging CAVs)", "{:.2f}"),
+    ("comfort_share_pct", "Comfort (% |a|<=1.47)", "{:.2f}"),
+    ("collisions", "Collisions", "{}"),
+    ("teleports", "Teleports", "{}"),
+    ("cavs_seen", "CAVs seen", "{}"),
+    ("exiting_cavs", "Exiting CAVs", "{}"),
+    ("merging_cavs", "Merging CAVs", "{}"),
+    ("sim_seconds", "Simulated (s)", "{:.0f}"),
+    ("wall_seconds", "Wall (s)", "{:.1f}"),
+    ("real_time_factor", "Real-time factor", "{:.2f}"),
+]
+
+
+def fmt(value, pattern):
+    if value is None:
+        return "n/a"
+    try:
+        return pattern.format(value)
+    except (ValueError, TypeError):
+        return str(value)
+
+
+def main(paths):
+    runs = [(pathlib.Path(p).parent.name, json.loads(pathlib.Path(p).read_text())) for p in paths]
+    width = max(14, *(len(n) for n, _ in runs))
+    print(f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs))
+    for key, label, pattern in ROWS:
+        print(f"{label:34s}" + "".join(f"{fmt(m.get(key), pattern):>{width + 2}s}" for _, m in runs))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
