@@ -1,0 +1,1 @@
+list(APPEND PALCAS_SIM_SOURCES lib/road_layout.cpp)

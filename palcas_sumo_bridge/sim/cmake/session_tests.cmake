@@ -1,0 +1,1 @@
+palcas_sim_add_gtest(road_layout_test test/road_layout_test.cpp)

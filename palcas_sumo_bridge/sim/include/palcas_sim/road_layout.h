@@ -1,0 +1,74 @@
+#pragma once
+// What the bridge needs to know about the road, derived from the SUMO network by the edge
+// naming convention of config/scenarios (see config/scenarios/README.md):
+//   main_*            mainline edges, running along +x from x = 0
+//   main_<k>_merge    the mainline edge of cluster k whose SUMO lane 0 is the acceleration lane
+//   on_<k>            the on-ramp of cluster k (joins main_<k>_merge's lane 0)
+//   off_<k>           the off-ramp of cluster k (leaves from lane 1, the rightmost main lane)
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace palcas::sim {
+
+enum class RoadPart { kMainline, kAccelLane, kOnRamp, kOffRamp, kUnknown };
+
+/// One edge of the network as the bridge sees it.
+struct EdgeInfo {
+  std::string id;
+  RoadPart part = RoadPart::kUnknown;  ///< for a merge edge: kMainline (lane 0 is kAccelLane)
+  int cluster = -1;                    ///< cluster index for ramps and merge edges, else -1
+  double x_start_m = 0.0;              ///< x of the edge's start along the mainline
+  double x_end_m = 0.0;
+  int lane_count = 0;                  ///< SUMO lanes on the edge
+  bool has_accel_lane = false;         ///< SUMO lane 0 is an acceleration lane
+};
+
+/// One RSU zone with its ramps.
+struct ClusterInfo {
+  int index = 0;
+  double x_start_m = 0.0;       ///< zone [x_start_m, x_end_m) along the mainline
+  double x_end_m = 0.0;
+  std::string on_ramp_edge;     ///< "" when the cluster has no on-ramp
+  std::string merge_edge;
+  double accel_lane_x_start_m = 0.0;
+  double accel_lane_length_m = 0.0;
+  std::string off_ramp_edge;    ///< "" when the cluster has no off-ramp
+  double exit_x_m = 0.0;        ///< x where the off-ramp leaves the mainline
+};
+
+/// Classifies edges by name and answers position questions.
+class RoadLayout {
+ public:
+  /// @param edges every edge of the network; @param cluster_length_m zone length (800 m)
+  /// @throws std::invalid_argument on a malformed name, a cluster without its merge edge,
+  ///         or a non-positive cluster length.
+  RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double cluster_length_m);
+
+  /// @throws std::out_of_range naming the edge when it is not part of the network.
+  const EdgeInfo& edge(const std::string& id) const;
+  bool hasEdge(const std::string& id) const { return index_.count(id) > 0; }
+  const std::vector<ClusterInfo>& clusters() const { return clusters_; }
+  int numMainLanes() const { return num_main_lanes_; }
+  double mainlineLengthM() const { return mainline_length_m_; }
+  /// Cluster whose zone holds x (clamped to the first/last cluster).
+  int clusterAt(double x_m) const;
+
+  /// Paper lane (1 = rightmost mainline lane .. L; 0 = not on a mainline lane) of a SUMO
+  /// lane index on an edge. This is the one place where the conventions meet.
+  int paperLane(const std::string& edge_id, int sumo_lane_index) const;
+  /// SUMO lane index on `edge_id` of paper lane `lane` (1..L), or -1 if the edge has no
+  /// such lane.
+  int sumoLaneIndex(const std::string& edge_id, int paper_lane) const;
+
+ private:
+  std::vector<EdgeInfo> edges_;
+  std::map<std::string, std::size_t> index_;
+  std::vector<ClusterInfo> clusters_;
+  int num_main_lanes_;
+  double cluster_length_m_;
+  double mainline_length_m_ = 0.0;
+};
+
+}  // namespace palcas::sim

@@ -1,0 +1,107 @@
+#include "palcas_sim/road_layout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace palcas::sim {
+namespace {
+
+bool startsWith(const std::string& s, const std::string& prefix) {
+  return s.compare(0, prefix.size(), prefix) == 0;
+}
+
+/// Cluster index in names like "on_2" or "main_1_merge"; -1 when there is none.
+int clusterIndexOf(const std::string& id, const std::string& prefix) {
+  const std::size_t begin = prefix.size();
+  std::size_t end = begin;
+  while (end < id.size() && std::isdigit(static_cast<unsigned char>(id[end]))) ++end;
+  if (end == begin) return -1;
+  return std::stoi(id.substr(begin, end - begin));
+}
+
+}  // namespace
+
+RoadLayout::RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double cluster_length_m)
+    : edges_(std::move(edges)), num_main_lanes_(num_main_lanes), cluster_length_m_(cluster_length_m) {
+  if (!(cluster_length_m_ > 0.0))
+    throw std::invalid_argument("RoadLayout: cluster length must be > 0, got " +
+                                std::to_string(cluster_length_m_));
+  if (num_main_lanes_ < 1)
+    throw std::invalid_argument("RoadLayout: need at least one mainline lane");
+  for (std::size_t i = 0; i < edges_.size(); ++i) {
+    EdgeInfo& e = edges_[i];
+    if (startsWith(e.id, "main_")) {
+      e.part = RoadPart::kMainline;
+      e.has_accel_lane = e.id.size() > 6 && e.id.rfind("_merge") == e.id.size() - 6;
+      e.cluster = e.has_accel_lane ? clusterIndexOf(e.id, "main_") : -1;
+      if (e.has_accel_lane && e.cluster < 0)
+        throw std::invalid_argument("RoadLayout: merge edge '" + e.id + "' has no cluster index");
+      mainline_length_m_ = std::max(mainline_length_m_, e.x_end_m);
+    } else if (startsWith(e.id, "on_")) {
+      e.part = RoadPart::kOnRamp;
+      e.cluster = clusterIndexOf(e.id, "on_");
+    } else if (startsWith(e.id, "off_")) {
+      e.part = RoadPart::kOffRamp;
+      e.cluster = clusterIndexOf(e.id, "off_");
+    }
+    index_[e.id] = i;
+  }
+  const int cluster_count = std::max(1, static_cast<int>(std::ceil(mainline_length_m_ / cluster_length_m_ - 1e-9)));
+  clusters_.resize(cluster_count);
+  for (int k = 0; k < cluster_count; ++k) {
+    clusters_[k].index = k;
+    clusters_[k].x_start_m = k * cluster_length_m_;
+    clusters_[k].x_end_m = std::min((k + 1) * cluster_length_m_, mainline_length_m_);
+  }
+  for (const EdgeInfo& e : edges_) {
+    if (e.cluster < 0) continue;
+    if (e.cluster >= cluster_count)
+      throw std::invalid_argument("RoadLayout: edge '" + e.id + "' names cluster " +
+                                  std::to_string(e.cluster) + " but the mainline has only " +
+                                  std::to_string(cluster_count));
+    ClusterInfo& c = clusters_[e.cluster];
+    if (e.part == RoadPart::kOnRamp) c.on_ramp_edge = e.id;
+    if (e.part == RoadPart::kOffRamp) {
+      c.off_ramp_edge = e.id;
+      c.exit_x_m = e.x_start_m;
+    }
+    if (e.has_accel_lane) {
+      c.merge_edge = e.id;
+      c.accel_lane_x_start_m = e.x_start_m;
+      c.accel_lane_length_m = e.x_end_m - e.x_start_m;
+    }
+  }
+  for (const ClusterInfo& c : clusters_)
+    if (!c.on_ramp_edge.empty() && c.merge_edge.empty())
+      throw std::invalid_argument("RoadLayout: cluster " + std::to_string(c.index) +
+                                  " has on-ramp '" + c.on_ramp_edge + "' but no merge edge");
+}
+
+const EdgeInfo& RoadLayout::edge(const std::string& id) const {
+  auto it = index_.find(id);
+  if (it == index_.end()) throw std::out_of_range("RoadLayout: unknown edge '" + id + "'");
+  return edges_[it->second];
+}
+
+int RoadLayout::clusterAt(double x_m) const {
+  const int k = static_cast<int>(std::floor(x_m / cluster_length_m_));
+  return std::clamp(k, 0, static_cast<int>(clusters_.size()) - 1);
+}
+
+int RoadLayout::paperLane(const std::string& edge_id, int sumo_lane_index) const {
+  const EdgeInfo& e = edge(edge_id);
+  if (e.part != RoadPart::kMainline || sumo_lane_index < 0 || sumo_lane_index >= e.lane_count)
+    return 0;
+  if (e.has_accel_lane) return sumo_lane_index;  // SUMO lane 0 is the acceleration lane (0)
+  return sumo_lane_index + 1;
+}
+
+int RoadLayout::sumoLaneIndex(const std::string& edge_id, int paper_lane) const {
+  const EdgeInfo& e = edge(edge_id);
+  if (e.part != RoadPart::kMainline || paper_lane < 1 || paper_lane > num_main_lanes_) return -1;
+  const int index = e.has_accel_lane ? paper_lane : paper_lane - 1;
+  return index < e.lane_count ? index : -1;
+}
+
+}  // namespace palcas::sim
