@@ -1,1 +1,5 @@
-# state_reward targets (filled by the state_reward area)
+# palcas_reward: the reward inspector (./palcas reward). nlohmann-json is header-only and
+# used only here, never in the library.
+add_executable(palcas_reward tools/reward_inspector.cpp)
+target_link_libraries(palcas_reward palcas_core)
+install(TARGETS palcas_reward RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

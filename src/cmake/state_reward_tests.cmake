@@ -1,1 +1,13 @@
-# state_reward tests (filled by the state_reward area)
+# state_reward tests: one gtest per module, plus one that runs the palcas_reward binary.
+palcas_core_add_gtest(state_layout_test test/state_layout_test.cpp)
+palcas_core_add_gtest(neighbours_test test/neighbours_test.cpp)
+palcas_core_add_gtest(state_builder_test test/state_builder_test.cpp)
+palcas_core_add_gtest(rss_test test/rss_test.cpp)
+palcas_core_add_gtest(reward_test test/reward_test.cpp)
+# reward_test also checks that config/reward.yaml lists every RewardParams constant.
+target_compile_definitions(reward_test PRIVATE
+  PALCAS_REWARD_YAML="${CMAKE_CURRENT_SOURCE_DIR}/../config/reward.yaml")
+palcas_core_add_gtest(reward_inspector_test test/reward_inspector_test.cpp)
+target_compile_definitions(reward_inspector_test PRIVATE
+  PALCAS_REWARD_BIN="$<TARGET_FILE:palcas_reward>")
+add_dependencies(reward_inspector_test palcas_reward)
