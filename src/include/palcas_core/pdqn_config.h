@@ -1,0 +1,42 @@
+#pragma once
+// Hyper-parameters of the PDQN agent. Defaults = the paper's Table "Hyper/Params"
+// (Simulation Setup) where it gives a value; the others are documented choices
+// (config/learning.yaml documents every key, src/doc/learning.md the reasons).
+
+#include <cstdint>
+#include <vector>
+
+namespace palcas {
+
+struct PdqnConfig {
+  int state_size = 45;                           ///< paper: 45
+  std::vector<int> hidden_sizes{256, 512, 256};  ///< paper: [256, 512, 256]
+  bool batch_norm = true;                        ///< paper: batch normalisation
+  float dropout = 0.1f;                          ///< paper: p = 0.1
+  float huber_delta = 1.0f;                      ///< paper: Huber loss (delta 1, PyTorch default)
+  float learning_rate = 1e-3f;                   ///< paper: AdamW lr 1e-3 (both networks)
+  float weight_decay = 1e-2f;                    ///< paper: AdamW weight decay 1e-2
+  float adam_beta1 = 0.9f;                       ///< PyTorch default
+  float adam_beta2 = 0.999f;                     ///< PyTorch default
+  float adam_eps = 1e-8f;                        ///< PyTorch default
+  int batch_size = 256;                          ///< paper: b = 256
+  float gamma = 0.995f;                          ///< paper: 0.995
+  int replay_capacity = 100000;                  ///< paper: B = 100 000
+  int target_update_steps = 15000;               ///< paper: C = 15 000 gradient steps
+  double epsilon_start = 1.0;                    ///< paper: 1.0
+  double epsilon_final = 0.02;                   ///< paper: 0.02
+  double epsilon_decay = 0.999985;               ///< paper: x0.999985 per exploring act()
+  float accel_min_mps2 = -4.5f;                  ///< paper: a2 in [-4.5, 2.6] m/s^2
+  float accel_max_mps2 = 2.6f;
+  /// Std of Gaussian noise (m/s^2) added to the greedy acceleration when exploring,
+  /// clipped to the bounds; 0 = none. Not in the paper.
+  float accel_noise_std_mps2 = 0.2f;
+  /// MP-DQN (Bester et al. 2019) multi-pass Q evaluation; off = P-DQN as the paper cites.
+  bool multi_pass = false;
+  uint64_t seed = 1;
+
+  /// Throws std::invalid_argument naming the first invalid field and its value.
+  void validate() const;
+};
+
+}  // namespace palcas
