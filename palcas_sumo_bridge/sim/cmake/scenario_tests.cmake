@@ -1,1 +1,12 @@
-# scenario tests
+# scenario tests: network vs sources, demand writer, and an in-process SUMO smoke run per
+# scenario (libsumo holds one simulation per process, hence one executable per scenario).
+palcas_sim_add_gtest(scenario_network_test test/scenario_network_test.cpp)
+palcas_sim_add_gtest(scenario_demand_test test/scenario_demand_test.cpp)
+foreach(scenario tiny paper)
+  palcas_sim_add_gtest(scenario_smoke_${scenario}_test test/scenario_smoke_test.cpp)
+  if(TARGET scenario_smoke_${scenario}_test)
+    target_compile_definitions(scenario_smoke_${scenario}_test PRIVATE
+      PALCAS_SMOKE_SCENARIO="${scenario}")
+    target_link_libraries(scenario_smoke_${scenario}_test sumocpp)
+  endif()
+endforeach()
