@@ -1,1 +1,1 @@
-list(APPEND PALCAS_SIM_SOURCES lib/road_layout.cpp)
+list(APPEND PALCAS_SIM_SOURCES lib/road_layout.cpp lib/lockstep.cpp)

@@ -1,1 +1,2 @@
 palcas_sim_add_gtest(road_layout_test test/road_layout_test.cpp)
+palcas_sim_add_gtest(lockstep_test test/lockstep_test.cpp)

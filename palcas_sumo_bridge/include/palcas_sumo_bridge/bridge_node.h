@@ -1,0 +1,77 @@
+#pragma once
+// The SUMO bridge node: a thin ROS shell around palcas_sim::SumoSession and palcas_core's
+// outcome tracker, metrics accumulator and advisory validator. One simulation step per
+// loop iteration: publish the state of step k, wait (lockstep) for the RSUs' advisories
+// for step k, apply them, advance SUMO to step k+1, measure.
+
+#include <palcas_msgs/AdvisoryArray.h>
+#include <palcas_msgs/RegisterRsu.h>
+#include <palcas_msgs/VehicleStateArray.h>
+#include <ros/ros.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "palcas_sim/lockstep.h"
+#include "palcas_sim/sumo_session.h"
+#include "palcas_sumo_bridge/bridge_options.h"
+#include "palcas_sumo_bridge/episode_measure.h"
+#include "palcas_sumo_bridge/run_files.h"
+#include "palcas_sumo_bridge/rviz_markers.h"
+
+namespace palcas::bridge {
+
+class BridgeNode {
+ public:
+  /// Loads options, generates the scenario into the run folder, starts SUMO, advertises,
+  /// subscribes and offers services. @throws std::exception naming what failed.
+  BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  /// Runs the episode to its duration (or until ROS shuts down), then writes metrics.json.
+  /// @return the process exit code.
+  int run();
+
+ private:
+  void advertise();
+  /// Start handshake: every expected RSU registered and ~min_subscribers listening, or
+  /// the startup timeout. @return false when some RSU did not register.
+  bool waitForPeers();
+  void publishStep();
+  void waitForAdvisories();
+  void applyAdvisories();
+  void advance();
+  void publishMetrics();
+  void onAdvisories(const palcas_msgs::AdvisoryArray::ConstPtr& msg);
+  bool onRegister(palcas_msgs::RegisterRsu::Request& req, palcas_msgs::RegisterRsu::Response& res);
+  void reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
+              const std::string& detail);
+  double wallSeconds() const;
+
+  ros::NodeHandle nh_, private_nh_;
+  BridgeOptions options_;
+  std::string sumocfg_path_;
+  std::unique_ptr<sim::SumoSession> session_;
+  std::unique_ptr<sim::Lockstep> lockstep_;
+  std::unique_ptr<RvizMarkers> markers_;
+  EpisodeMeasure measure_;
+
+  ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,
+      markers_pub_, tf_pub_;
+  ros::Subscriber advisories_sub_;
+  ros::ServiceServer register_srv_;
+
+  palcas_msgs::VehicleStateArray current_states_;
+  /// Advisory arrays received for the open step, by RSU, in arrival order.
+  std::vector<palcas_msgs::AdvisoryArray::ConstPtr> pending_;
+  /// CAVs that have been advised at least once: without a fresh advisory they hold speed.
+  std::unordered_set<std::string> controlled_;
+  std::map<std::string, std::uint64_t> late_by_rsu_;
+  std::chrono::steady_clock::time_point wall_start_;
+  double next_metrics_s_ = 0.0;
+};
+
+}  // namespace palcas::bridge

@@ -1,0 +1,52 @@
+#pragma once
+// Every parameter of the bridge node in one struct, loaded in one place
+// (loadBridgeOptions, the only caller of getParam). Defaults and meaning: README.md of
+// this package and config/bridge.yaml.
+
+#include <ros/node_handle.h>
+
+#include <string>
+#include <vector>
+
+#include "palcas_sim/scenario.h"
+#include "palcas_sim/sumo_session.h"
+
+namespace palcas::bridge {
+
+struct BridgeOptions {
+  // Scenario and run: ~scenario/* (config/scenarios/<name>/scenario.yaml) holds the road's
+  // demand, PR, seed, duration and cluster length; ~scenario_dir overrides its folder.
+  sim::ScenarioConfig scenario;
+  std::string out_dir;             ///< run folder: generated scenario, metrics.json, manifest.json
+  std::string command_line;        ///< how the run was started, for the manifest
+  std::string git_commit;          ///< for the manifest
+  // SUMO.
+  bool gui = false;                ///< true: external sumo-gui over libtraci
+  bool sumo_warnings = false;      ///< true: SUMO's warnings on the console and in <out_dir>/sumo.log
+  sim::SessionOptions session;
+  // Lockstep with the RSUs.
+  std::vector<std::string> expected_rsus;  ///< empty = no RSUs (SUMO-native)
+  double lockstep_deadline_s = 0.2;        ///< wall time an RSU has to answer a step [s]
+  double startup_timeout_s = 30.0;         ///< wall time to wait for every RSU to register [s]
+  int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
+  int lost_after_missed_steps = 50;        ///< consecutive misses before an RSU is lost
+  int max_advisory_age_steps = 0;          ///< 0 = an advisory must answer the current step
+  // Pace and outputs.
+  double real_time_factor = 0.0;   ///< 0 = as fast as possible; e.g. 1.0 = real time
+  double metrics_period_s = 10.0;  ///< simulated time between EpisodeMetrics messages [s]
+  double linger_s = 1.0;           ///< wall time to stay up after the episode, so subscribers drain [s]
+  int markers_every_steps = 5;     ///< rviz markers every N steps (only with subscribers)
+  bool publish_tf = true;          ///< map -> vehicle and map -> RSU zone frames (only with subscribers)
+  // Metrics rules.
+  double exit_miss_margin_m = 20.0;   ///< on the mainline this far past its exit = missed [m]
+  double merge_stop_speed_mps = 0.1;  ///< "stopped" below this speed [m/s] ...
+  double merge_stop_window_m = 10.0;  ///< ... within this distance of the acceleration lane's end [m]
+  double comfort_threshold_mps2 = 1.47;
+};
+
+/// Reads the private parameters of the node, ~scenario/* included. @throws
+/// std::invalid_argument naming the key for a value out of range, a wrong type, or an
+/// unknown key under the node's namespace.
+BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh);
+
+}  // namespace palcas::bridge

@@ -1,0 +1,64 @@
+#pragma once
+// The run folder of one episode: the generated scenario, manifest.json (what ran: config
+// snapshot and hash, seeds, SUMO version, git commit, command line) and metrics.json.
+
+#include <palcas_core/episode_metrics.h>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "palcas_sim/scenario.h"
+#include "palcas_sim/sumo_session.h"
+#include "palcas_sumo_bridge/bridge_options.h"
+#include "palcas_sumo_bridge/episode_measure.h"
+
+namespace palcas::bridge {
+
+/// Bridge cost per step against the number of vehicles on the road: SUMO's own step and
+/// the bridge's work around it (conversion, publishing, measuring), in buckets of 50 vehicles.
+class StepTimer {
+ public:
+  void add(std::size_t vehicles, double sumo_s, double bridge_s);
+  struct Bucket {
+    std::uint64_t steps = 0;
+    double sumo_s = 0.0;
+    double bridge_s = 0.0;
+  };
+  const std::map<std::size_t, Bucket>& buckets() const { return buckets_; }
+  static constexpr std::size_t BUCKET_WIDTH = 50;
+
+ private:
+  std::map<std::size_t, Bucket> buckets_;  ///< key = first vehicle count of the bucket
+};
+
+struct RunSummary {
+  metrics::EpisodeMetrics metrics;
+  double wall_seconds = 0.0;
+  std::uint64_t steps = 0;
+  std::map<std::string, std::uint64_t> late_by_rsu;
+  std::map<std::string, std::uint64_t> rejections_by_reason;
+  StepTimer timing;
+};
+
+/// Generates the scenario into <out_dir>/scenario and writes manifest.json.
+/// @return the .sumocfg path. @throws std::exception naming what failed.
+std::string prepareScenario(const BridgeOptions& options);
+
+/// SUMO session options for a generated scenario.
+sim::SessionOptions sessionOptionsFor(const BridgeOptions& options, const std::string& sumocfg);
+
+/// Adds the SUMO version, API and the measuring rules (exit positions, thresholds, which
+/// metrics_from_bag needs) to <out_dir>/manifest.json once SUMO runs.
+void completeManifest(const BridgeOptions& options, const std::string& sumo_version,
+                      const std::string& api_name, const MeasureRules& rules);
+
+/// The measuring rules stored in a manifest.json. @throws std::runtime_error naming what
+/// is missing when the file is not a PALCAS manifest.
+MeasureRules readMeasureRules(const std::string& manifest_path);
+
+/// Writes <out_dir>/metrics.json atomically (NaN as null).
+void writeMetricsJson(const BridgeOptions& options, const RunSummary& summary);
+
+}  // namespace palcas::bridge

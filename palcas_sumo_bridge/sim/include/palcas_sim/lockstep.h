@@ -1,0 +1,59 @@
+#pragma once
+// Lockstep bookkeeping between the bridge and its RSUs, without ROS: who is expected, who
+// registered, who has answered the current step, who is late or lost. The bridge node
+// asks complete() while it waits, up to its deadline.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace palcas::sim {
+
+class Lockstep {
+ public:
+  /// @param expected_rsus RSU ids the bridge waits for (empty = no lockstep).
+  /// @param lost_after_missed_steps consecutive missed deadlines after which an RSU is
+  ///        considered lost and no longer waited for (it is live again when it answers).
+  /// @throws std::invalid_argument on duplicate or empty ids, or lost_after < 1.
+  Lockstep(std::vector<std::string> expected_rsus, int lost_after_missed_steps);
+
+  /// Start handshake. @return false (with *reason) for an RSU that is not expected.
+  bool registerRsu(const std::string& rsu_id, std::string* reason);
+  bool allRegistered() const;
+  std::vector<std::string> unregistered() const;
+
+  /// Opens step `step`: from now on answers for it count.
+  void beginStep(std::uint64_t step);
+  enum class Answer { kAccepted, kUnknownRsu, kStale, kDuplicate };
+  /// Records that `rsu_id` answered `step`.
+  Answer onAnswer(const std::string& rsu_id, std::uint64_t step);
+  /// True when every live, registered RSU has answered the open step.
+  bool complete() const;
+  /// Live RSUs that have not answered the open step yet.
+  std::vector<std::string> waitingFor() const;
+  /// Closes the open step. @return the RSUs that missed it (late). Updates lost status;
+  /// *newly_lost receives the ones lost on this step.
+  std::vector<std::string> endStep(std::vector<std::string>* newly_lost);
+
+  bool enabled() const { return !rsus_.empty(); }
+  bool isLive(const std::string& rsu_id) const;
+  std::uint64_t lateSteps() const { return late_steps_; }
+  std::uint64_t lateAnswers(const std::string& rsu_id) const;
+
+ private:
+  struct RsuStatus {
+    bool registered = false;
+    bool answered = false;
+    bool lost = false;
+    int consecutive_misses = 0;
+    std::uint64_t late_answers = 0;
+  };
+  std::map<std::string, RsuStatus> rsus_;
+  int lost_after_;
+  std::uint64_t open_step_ = 0;
+  bool step_open_ = false;
+  std::uint64_t late_steps_ = 0;
+};
+
+}  // namespace palcas::sim

@@ -1,0 +1,168 @@
+#pragma once
+// SumoSession: one running SUMO simulation seen the way PALCAS needs it. It starts SUMO
+// (in-process through libsumo, or an external sumo/sumo-gui through libtraci: the same
+// source is compiled once per API), reads every vehicle with subscriptions each step,
+// applies advisories to CAVs and handles exits. No ROS in here.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "palcas_sim/road_layout.h"
+
+namespace palcas::sim {
+
+/// Route kinds, numbered as palcas_msgs/VehicleState.ROUTE_*.
+enum class RouteKind : int { kMainThrough = 0, kMainExit = 1, kRampThrough = 2, kRampExit = 3 };
+
+/// Longitudinal command a CAV holds between advisories.
+enum class HeldCommand { kNone, kKeepSpeed, kAccelerate };
+
+struct SessionOptions {
+  std::vector<std::string> sumo_args;  ///< arguments after the binary, e.g. {"-c", "x.sumocfg"}
+  std::string sumo_binary = "sumo";    ///< libtraci only: "sumo" or "sumo-gui"
+  int traci_port = -1;                 ///< libtraci only: -1 = let SUMO choose
+  double cluster_length_m = 800.0;
+  /// true: CAVs follow advisories (RSU arms); false: SUMO drives every vehicle (SUMO-native).
+  bool advisory_control = false;
+  /// SUMO speed-mode bits for CAVs under advisory control (31 = SUMO keeps its safe-speed,
+  /// acceleration and right-of-way checks; 30 lets advisories override the safe speed).
+  int cav_speed_mode = 31;
+  /// SUMO lane-change-mode bits for CAVs under advisory control. 256 = no strategic,
+  /// cooperative, speed-gain or keep-right changes of its own (so only advisories change
+  /// lanes and a CAV can miss its exit); advised changes avoid immediate collisions only.
+  int cav_lane_change_mode = 256;
+  double lane_change_duration_s = 2.0;  ///< an advised lane change not done by then is dropped
+};
+
+/// One vehicle on the road, updated every step.
+struct VehicleRecord {
+  // Fixed at departure.
+  std::string id;
+  std::string type_id;
+  std::string route_id;
+  bool is_cav = false;
+  RouteKind route_kind = RouteKind::kMainThrough;
+  int entry_cluster = -1;  ///< cluster of its on-ramp, -1 = mainline start
+  int exit_cluster = -1;   ///< cluster of its off-ramp, -1 = no exit
+  double length_m = 0.0;
+  double width_m = 0.0;
+  double max_speed_mps = 0.0;
+  // Read every step.
+  std::string edge;
+  int sumo_lane_index = -1;
+  int lane = 0;            ///< paper lane, 0 = not on a mainline lane
+  RoadPart part = RoadPart::kUnknown;
+  int part_cluster = -1;   ///< cluster of the ramp / merge edge it is on, else -1
+  double x_m = 0.0;
+  double map_y_m = 0.0;      ///< y in SUMO's map frame (for drawing)
+  double heading_rad = 0.0;  ///< driving direction in the map frame, 0 = +x, counter-clockwise
+  double lateral_m = 0.0;
+  double speed_mps = 0.0;
+  double accel_mps2 = 0.0;
+  double lateral_speed_mps = 0.0;
+  double lane_pos_m = 0.0;
+  double distance_to_exit_m = 0.0;  ///< +inf without an exit or once it is behind
+  bool on_accel_lane = false;
+  double accel_lane_pos_m = 0.0;
+  double accel_lane_length_m = 0.0;
+  // Advisory control state.
+  HeldCommand command = HeldCommand::kNone;
+  double command_value = 0.0;  ///< held speed [m/s] or acceleration [m/s^2]
+  bool exit_committed = false; ///< SUMO target switched to its off-ramp
+  /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
+  /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
+  /// differ (a merge edge), until the target lane is reached or the time is up.
+  int lane_change_target = 0;       ///< paper lane, 0 = none
+  double lane_change_until_s = 0.0; ///< simulation time the request expires
+  std::string lane_change_edge;     ///< edge the request was last issued on
+};
+
+/// What happened during one step besides vehicles moving.
+struct StepEvents {
+  std::vector<std::string> departed;
+  std::vector<std::string> arrived;     ///< left the network normally
+  std::vector<std::string> collided;    ///< removed after a collision
+  std::vector<std::string> teleported;  ///< started a teleport
+  /// Records of vehicles that left this step (arrived, collided or teleported), as last seen.
+  std::vector<VehicleRecord> removed;
+};
+
+class SumoSession {
+ public:
+  /// Starts SUMO and reads the network. @throws std::runtime_error with SUMO's message
+  /// when SUMO cannot start, or std::invalid_argument when the network breaks the naming
+  /// convention of road_layout.h.
+  explicit SumoSession(const SessionOptions& options);
+  ~SumoSession();
+  SumoSession(const SumoSession&) = delete;
+  SumoSession& operator=(const SumoSession&) = delete;
+
+  /// Applies held commands, advances SUMO by one step, reads every vehicle.
+  const StepEvents& step();
+  /// What the latest step() reported (empty before the first step).
+  const StepEvents& lastEvents() const { return events_; }
+
+  /// Simulation time [s] and step count since start.
+  double timeS() const { return time_s_; }
+  std::uint64_t stepCount() const { return step_count_; }
+  double stepLengthS() const { return step_length_s_; }
+  /// Vehicles still expected (on the road, waiting to depart or loaded later).
+  int minExpectedVehicles() const;
+  const RoadLayout& road() const { return *road_; }
+  /// Centre lines (x, y) of every lane of the network, for drawing.
+  const std::vector<std::vector<std::pair<double, double>>>& laneShapes() const {
+    return lane_shapes_;
+  }
+  const std::vector<VehicleRecord>& vehicles() const { return vehicles_; }
+  /// nullptr when no such vehicle is on the road.
+  const VehicleRecord* find(const std::string& id) const;
+
+  /// Applies an already validated advisory (action code as palcas::Action) to a CAV:
+  /// lane changes go through SUMO's changeLane for lane_change_duration_s while the speed
+  /// is held; ACCELERATE holds `accel_mps2`; KEEP holds the current speed.
+  /// @throws std::invalid_argument for an unknown vehicle or a lane that does not exist.
+  void applyAdvisory(const std::string& id, int action, double accel_mps2);
+  /// A controlled CAV that received no advisory this step keeps its current speed (not on
+  /// an off-ramp, where SUMO drives it again).
+  void holdSpeed(const std::string& id);
+
+  /// "sumo x.y.z" of the running SUMO.
+  std::string sumoVersion() const;
+  /// Which C++ API this session was compiled against ("libsumo" or "libtraci").
+  static const char* apiName();
+
+ private:
+  void readNetwork();
+  void onDeparted(const std::string& id);
+  void readVehicles();
+  void updateDerived(VehicleRecord& v) const;
+  void manageExit(VehicleRecord& v);
+  void continueLaneChange(VehicleRecord& v);
+  void requestLaneChange(VehicleRecord& v, double duration_s);
+  void applyHeldCommand(VehicleRecord& v);
+  void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
+
+  SessionOptions options_;
+  std::unique_ptr<RoadLayout> road_;
+  std::string end_edge_;         ///< last mainline edge: where onward routes go
+  std::unordered_map<int, std::string> pre_exit_edge_;  ///< cluster -> mainline edge feeding its off-ramp
+  std::vector<std::vector<std::pair<double, double>>> lane_shapes_;
+  double lane_width_m_ = 3.2;
+  double step_length_s_ = 0.1;
+  double time_s_ = 0.0;
+  std::uint64_t step_count_ = 0;
+  std::vector<VehicleRecord> vehicles_;
+  std::unordered_map<std::string, std::size_t> index_;
+  StepEvents events_;
+  bool open_ = false;
+};
+
+/// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
+/// to: end | off<k>). @throws std::invalid_argument for another form.
+void parseRouteId(const std::string& route_id, RouteKind* kind, int* entry_cluster,
+                  int* exit_cluster);
+
+}  // namespace palcas::sim

@@ -1,0 +1,377 @@
+// Compiled twice: as is against libsumo (SUMO in-process), and with LIBTRACI defined
+// against libtraci (a client of an external sumo / sumo-gui). LIBSUMO_NAMESPACE names the
+// API namespace in both cases; the result types stay in namespace libsumo.
+#ifdef PALCAS_USE_LIBTRACI
+#include <libsumo/libtraci.h>
+#else
+#include <libsumo/libsumo.h>
+#endif
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "palcas_sim/sumo_session.h"
+
+namespace palcas::sim {
+namespace api = LIBSUMO_NAMESPACE;
+
+namespace {
+
+constexpr double INF = std::numeric_limits<double>::infinity();
+// Action codes as palcas::Action / palcas_msgs/Advisory.
+constexpr int LANE_LEFT = 0, LANE_RIGHT = 1, ACCELERATE = 2, KEEP = 3;
+
+const std::vector<int>& vehicleVariables() {
+  static const std::vector<int> vars = {
+      libsumo::VAR_POSITION,   libsumo::VAR_SPEED,      libsumo::VAR_ACCELERATION,
+      libsumo::VAR_SPEED_LAT,  libsumo::VAR_ROAD_ID,    libsumo::VAR_LANE_INDEX,
+      libsumo::VAR_LANEPOSITION, libsumo::VAR_LANEPOSITION_LAT, libsumo::VAR_ANGLE};
+  return vars;
+}
+
+double asDouble(const libsumo::TraCIResults& r, int var) {
+  auto it = r.find(var);
+  if (it == r.end()) return std::numeric_limits<double>::quiet_NaN();
+  if (auto d = std::dynamic_pointer_cast<libsumo::TraCIDouble>(it->second)) return d->value;
+  if (auto i = std::dynamic_pointer_cast<libsumo::TraCIInt>(it->second)) return i->value;
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+std::string asString(const libsumo::TraCIResults& r, int var) {
+  auto it = r.find(var);
+  if (it == r.end()) return {};
+  if (auto s = std::dynamic_pointer_cast<libsumo::TraCIString>(it->second)) return s->value;
+  return {};
+}
+
+std::vector<std::string> asStringList(const libsumo::TraCIResults& r, int var) {
+  auto it = r.find(var);
+  if (it == r.end()) return {};
+  if (auto s = std::dynamic_pointer_cast<libsumo::TraCIStringList>(it->second)) return s->value;
+  return {};
+}
+
+int clusterSuffix(const std::string& s, const std::string& prefix) {
+  if (s.compare(0, prefix.size(), prefix) != 0 || s.size() == prefix.size()) return -2;
+  for (std::size_t i = prefix.size(); i < s.size(); ++i)
+    if (!std::isdigit(static_cast<unsigned char>(s[i]))) return -2;
+  return std::stoi(s.substr(prefix.size()));
+}
+
+}  // namespace
+
+void parseRouteId(const std::string& route_id, RouteKind* kind, int* entry_cluster,
+                  int* exit_cluster) {
+  const std::size_t first = route_id.find('_');
+  const std::size_t second = route_id.find('_', first + 1);
+  if (route_id.compare(0, 2, "r_") != 0 || second == std::string::npos)
+    throw std::invalid_argument("route id '" + route_id + "' is not of the form r_<from>_<to>");
+  const std::string from = route_id.substr(first + 1, second - first - 1);
+  const std::string to = route_id.substr(second + 1);
+  const int entry = from == "main" ? -1 : clusterSuffix(from, "on");
+  const int exit = to == "end" ? -1 : clusterSuffix(to, "off");
+  if (entry == -2 || exit == -2)
+    throw std::invalid_argument("route id '" + route_id +
+                                "': origin must be main|on<k> and destination end|off<k>");
+  *entry_cluster = entry;
+  *exit_cluster = exit;
+  if (entry < 0) *kind = exit < 0 ? RouteKind::kMainThrough : RouteKind::kMainExit;
+  else *kind = exit < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
+}
+
+const char* SumoSession::apiName() {
+#ifdef PALCAS_USE_LIBTRACI
+  return "libtraci";
+#else
+  return "libsumo";
+#endif
+}
+
+SumoSession::SumoSession(const SessionOptions& options) : options_(options) {
+  std::vector<std::string> cmd{options_.sumo_binary};
+#ifndef PALCAS_USE_LIBTRACI
+  cmd[0] = "sumo";  // in-process: the binary name is only argv[0]
+#endif
+  cmd.insert(cmd.end(), options_.sumo_args.begin(), options_.sumo_args.end());
+  try {
+#ifdef PALCAS_USE_LIBTRACI
+    api::Simulation::start(cmd, options_.traci_port);
+#else
+    api::Simulation::load(std::vector<std::string>(cmd.begin() + 1, cmd.end()));
+#endif
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("SUMO did not start (") + apiName() + "): " + e.what());
+  }
+  open_ = true;
+  step_length_s_ = api::Simulation::getDeltaT();
+  time_s_ = api::Simulation::getTime();
+  const std::vector<int> sim_vars{
+      libsumo::VAR_DEPARTED_VEHICLES_IDS, libsumo::VAR_ARRIVED_VEHICLES_IDS,
+      libsumo::VAR_COLLIDING_VEHICLES_IDS, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS};
+  api::Simulation::subscribe(sim_vars);
+  readNetwork();
+}
+
+SumoSession::~SumoSession() {
+  if (!open_) return;
+  try {
+    api::Simulation::close();
+  } catch (...) {
+    // Closing a simulation that already ended must not throw from a destructor.
+  }
+}
+
+void SumoSession::readNetwork() {
+  std::vector<EdgeInfo> edges;
+  int main_lanes = 0;
+  for (const std::string& id : api::Edge::getIDList()) {
+    if (id.empty() || id[0] == ':') continue;  // junction-internal edges
+    EdgeInfo e;
+    e.id = id;
+    e.lane_count = api::Edge::getLaneNumber(id);
+    const auto shape = api::Lane::getShape(id + "_" + std::to_string(e.lane_count - 1)).value;
+    e.x_start_m = shape.front().x;
+    e.x_end_m = shape.back().x;
+    edges.push_back(e);
+    for (int lane = 0; lane < e.lane_count; ++lane) {
+      std::vector<std::pair<double, double>> line;
+      for (const auto& p : api::Lane::getShape(id + "_" + std::to_string(lane)).value)
+        line.emplace_back(p.x, p.y);
+      lane_shapes_.push_back(std::move(line));
+    }
+    if (id.compare(0, 5, "main_") == 0 && id.find("_merge") == std::string::npos)
+      main_lanes = std::max(main_lanes, e.lane_count);
+  }
+  road_ = std::make_unique<RoadLayout>(edges, main_lanes, options_.cluster_length_m);
+  double end_x = -INF;
+  for (const EdgeInfo& e : edges) {
+    if (e.id.compare(0, 5, "main_") == 0 && e.x_end_m > end_x) {
+      end_x = e.x_end_m;
+      end_edge_ = e.id;
+    }
+  }
+  // The mainline edge feeding an off-ramp: the one whose end is where the ramp starts.
+  for (const ClusterInfo& c : road_->clusters()) {
+    if (c.off_ramp_edge.empty()) continue;
+    for (const EdgeInfo& e : edges)
+      if (e.id.compare(0, 5, "main_") == 0 && std::abs(e.x_end_m - c.exit_x_m) < 1.0)
+        pre_exit_edge_[c.index] = e.id;
+  }
+  for (const EdgeInfo& e : edges)
+    if (e.id.compare(0, 5, "main_") == 0 && !e.has_accel_lane) {
+      lane_width_m_ = api::Lane::getWidth(e.id + "_0");
+      break;
+    }
+}
+
+int SumoSession::minExpectedVehicles() const { return api::Simulation::getMinExpectedNumber(); }
+
+std::string SumoSession::sumoVersion() const { return api::Simulation::getVersion().second; }
+
+const VehicleRecord* SumoSession::find(const std::string& id) const {
+  auto it = index_.find(id);
+  return it == index_.end() ? nullptr : &vehicles_[it->second];
+}
+
+const StepEvents& SumoSession::step() {
+  for (VehicleRecord& v : vehicles_) applyHeldCommand(v);
+  api::Simulation::step();
+  ++step_count_;
+  time_s_ = api::Simulation::getTime();
+
+  events_ = StepEvents{};
+  const libsumo::TraCIResults sim = api::Simulation::getSubscriptionResults();
+  events_.departed = asStringList(sim, libsumo::VAR_DEPARTED_VEHICLES_IDS);
+  events_.arrived = asStringList(sim, libsumo::VAR_ARRIVED_VEHICLES_IDS);
+  events_.collided = asStringList(sim, libsumo::VAR_COLLIDING_VEHICLES_IDS);
+  events_.teleported = asStringList(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS);
+  // Colliding vehicles are removed by SUMO (collision.action remove) and may also be
+  // listed as arrived; each leaves once.
+  for (const std::string& id : events_.collided) removeVehicle(id, &events_.removed);
+  for (const std::string& id : events_.teleported) removeVehicle(id, &events_.removed);
+  for (const std::string& id : events_.arrived) removeVehicle(id, &events_.removed);
+  for (const std::string& id : events_.departed) onDeparted(id);
+  readVehicles();
+  return events_;
+}
+
+void SumoSession::removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed) {
+  auto it = index_.find(id);
+  if (it == index_.end()) return;
+  const std::size_t i = it->second;
+  if (removed) removed->push_back(vehicles_[i]);
+  index_.erase(it);
+  if (i != vehicles_.size() - 1) {
+    vehicles_[i] = std::move(vehicles_.back());
+    index_[vehicles_[i].id] = i;
+  }
+  vehicles_.pop_back();
+}
+
+void SumoSession::onDeparted(const std::string& id) {
+  VehicleRecord v;
+  v.id = id;
+  v.type_id = api::Vehicle::getTypeID(id);
+  v.route_id = api::Vehicle::getRouteID(id);
+  v.is_cav = v.type_id.compare(0, 3, "cav") == 0;
+  try {
+    parseRouteId(v.route_id, &v.route_kind, &v.entry_cluster, &v.exit_cluster);
+  } catch (const std::invalid_argument&) {
+    v.route_kind = RouteKind::kMainThrough;  // foreign routes: tracked, never controlled
+  }
+  v.length_m = api::Vehicle::getLength(id);
+  v.width_m = api::Vehicle::getWidth(id);
+  v.max_speed_mps = api::Vehicle::getMaxSpeed(id);
+  api::Vehicle::subscribe(id, vehicleVariables());
+  if (v.is_cav && options_.advisory_control) {
+    api::Vehicle::setSpeedMode(id, options_.cav_speed_mode);
+    api::Vehicle::setLaneChangeMode(id, options_.cav_lane_change_mode);
+    // Controlled CAVs drive towards the mainline end; the bridge switches the target to the
+    // off-ramp only once the CAV is in lane 1 just before it, so a CAV that does not get
+    // there in time really misses its exit (SUMO's strategic changes are off).
+    if (v.exit_cluster >= 0 && !end_edge_.empty()) api::Vehicle::changeTarget(id, end_edge_);
+  }
+  index_[id] = vehicles_.size();
+  vehicles_.push_back(std::move(v));
+}
+
+void SumoSession::readVehicles() {
+  const libsumo::SubscriptionResults all = api::Vehicle::getAllSubscriptionResults();
+  for (VehicleRecord& v : vehicles_) {
+    auto it = all.find(v.id);
+    if (it == all.end()) continue;  // teleporting vehicles are off the road this step
+    const libsumo::TraCIResults& r = it->second;
+    auto pos = r.find(libsumo::VAR_POSITION);
+    if (pos != r.end())
+      if (auto p = std::dynamic_pointer_cast<libsumo::TraCIPosition>(pos->second)) {
+        v.x_m = p->x;
+        v.map_y_m = p->y;
+      }
+    // SUMO's angle: degrees clockwise from north (+y); ours: radians counter-clockwise from +x.
+    v.heading_rad = (90.0 - asDouble(r, libsumo::VAR_ANGLE)) * M_PI / 180.0;
+    v.speed_mps = asDouble(r, libsumo::VAR_SPEED);
+    v.accel_mps2 = asDouble(r, libsumo::VAR_ACCELERATION);
+    v.lateral_speed_mps = asDouble(r, libsumo::VAR_SPEED_LAT);
+    v.edge = asString(r, libsumo::VAR_ROAD_ID);
+    v.sumo_lane_index = static_cast<int>(asDouble(r, libsumo::VAR_LANE_INDEX));
+    v.lane_pos_m = asDouble(r, libsumo::VAR_LANEPOSITION);
+    v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
+    updateDerived(v);
+    if (v.lane_change_target != 0) continueLaneChange(v);
+    if (v.is_cav && options_.advisory_control) manageExit(v);
+  }
+}
+
+void SumoSession::updateDerived(VehicleRecord& v) const {
+  const double offset_in_lane = v.lateral_m;
+  if (!road_->hasEdge(v.edge)) {  // on a junction-internal edge: keep last lane and part
+    v.lateral_m = (v.lane - 0.5) * lane_width_m_ + offset_in_lane;
+    return;
+  }
+  const EdgeInfo& e = road_->edge(v.edge);
+  v.lane = road_->paperLane(v.edge, v.sumo_lane_index);
+  v.on_accel_lane = e.has_accel_lane && v.sumo_lane_index == 0;
+  v.part = v.on_accel_lane ? RoadPart::kAccelLane : e.part;
+  v.part_cluster = e.cluster;
+  v.accel_lane_pos_m = v.on_accel_lane ? v.lane_pos_m : 0.0;
+  v.accel_lane_length_m = v.on_accel_lane ? e.x_end_m - e.x_start_m : 0.0;
+  // Lateral position from the right edge of lane 1; the acceleration lane and ramps sit
+  // at negative values (one lane width to the right of lane 1).
+  const int lane_for_lateral = v.part == RoadPart::kMainline ? v.lane : 0;
+  v.lateral_m = (lane_for_lateral - 0.5) * lane_width_m_ + offset_in_lane;
+  v.distance_to_exit_m = INF;
+  if (v.exit_cluster >= 0 && v.part != RoadPart::kOffRamp) {
+    const double exit_x = road_->clusters()[v.exit_cluster].exit_x_m;
+    if (v.x_m <= exit_x) v.distance_to_exit_m = exit_x - v.x_m;
+  }
+}
+
+void SumoSession::manageExit(VehicleRecord& v) {
+  if (v.exit_cluster < 0 || v.part == RoadPart::kOffRamp) return;
+  auto it = pre_exit_edge_.find(v.exit_cluster);
+  if (it == pre_exit_edge_.end() || v.edge != it->second) return;
+  // On the edge feeding its off-ramp: commit to the exit while in lane 1, withdraw when it
+  // leaves lane 1 (the off-ramp only connects from lane 1).
+  const bool in_exit_lane = v.lane == 1;
+  if (in_exit_lane && !v.exit_committed) {
+    api::Vehicle::changeTarget(v.id, road_->clusters()[v.exit_cluster].off_ramp_edge);
+    v.exit_committed = true;
+  } else if (!in_exit_lane && v.exit_committed) {
+    api::Vehicle::changeTarget(v.id, end_edge_);
+    v.exit_committed = false;
+  }
+}
+
+void SumoSession::requestLaneChange(VehicleRecord& v, double duration_s) {
+  const int index = road_->sumoLaneIndex(v.edge, v.lane_change_target);
+  if (index < 0) {  // the target lane does not exist on this edge (e.g. the road narrows)
+    v.lane_change_target = 0;
+    return;
+  }
+  api::Vehicle::changeLane(v.id, index, duration_s);
+  v.lane_change_edge = v.edge;
+}
+
+void SumoSession::continueLaneChange(VehicleRecord& v) {
+  if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
+    v.lane_change_target = 0;  // done, or aborted after lane_change_duration_s
+    return;
+  }
+  if (v.edge != v.lane_change_edge && road_->hasEdge(v.edge))
+    requestLaneChange(v, v.lane_change_until_s - time_s_);
+}
+
+void SumoSession::applyAdvisory(const std::string& id, int action, double accel_mps2) {
+  auto it = index_.find(id);
+  if (it == index_.end()) throw std::invalid_argument("applyAdvisory: unknown vehicle '" + id + "'");
+  VehicleRecord& v = vehicles_[it->second];
+  if (action == LANE_LEFT || action == LANE_RIGHT) {
+    const int target_lane = action == LANE_LEFT ? v.lane + 1 : v.lane - 1;
+    if (road_->sumoLaneIndex(v.edge, target_lane) < 0)
+      throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
+                                  "' has no lane " + std::to_string(target_lane));
+    v.lane_change_target = target_lane;
+    v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
+    requestLaneChange(v, options_.lane_change_duration_s);
+    v.command = HeldCommand::kKeepSpeed;
+    v.command_value = v.speed_mps;
+  } else if (action == ACCELERATE) {
+    v.command = HeldCommand::kAccelerate;
+    v.command_value = accel_mps2;
+  } else if (action == KEEP) {
+    v.command = HeldCommand::kKeepSpeed;
+    v.command_value = v.speed_mps;
+  } else {
+    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
+  }
+}
+
+void SumoSession::holdSpeed(const std::string& id) {
+  auto it = index_.find(id);
+  if (it == index_.end()) return;
+  VehicleRecord& v = vehicles_[it->second];
+  if (v.part == RoadPart::kOffRamp) return;
+  v.command = HeldCommand::kKeepSpeed;
+  v.command_value = v.speed_mps;
+}
+
+void SumoSession::applyHeldCommand(VehicleRecord& v) {
+  if (v.command == HeldCommand::kNone) return;
+  if (v.part == RoadPart::kOffRamp) {
+    // Left the mainline: SUMO drives it from here. Release once.
+    api::Vehicle::setSpeed(v.id, -1.0);
+    v.command = HeldCommand::kNone;
+    return;
+  }
+  if (v.command == HeldCommand::kKeepSpeed) {
+    api::Vehicle::setSpeed(v.id, v.command_value);
+  } else {
+    // Holding an acceleration: aim each step at the speed it reaches in one step.
+    api::Vehicle::setSpeed(v.id, std::max(0.0, v.speed_mps + v.command_value * step_length_s_));
+  }
+}
+
+}  // namespace palcas::sim

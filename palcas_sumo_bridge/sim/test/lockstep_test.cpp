@@ -1,0 +1,85 @@
+#include "palcas_sim/lockstep.h"
+
+#include <gtest/gtest.h>
+
+using palcas::sim::Lockstep;
+
+TEST(Lockstep, WaitsForEveryRegisteredRsu) {
+  Lockstep ls({"rsu_0", "rsu_1"}, 3);
+  EXPECT_TRUE(ls.enabled());
+  EXPECT_FALSE(ls.allRegistered());
+  std::string reason;
+  EXPECT_TRUE(ls.registerRsu("rsu_0", &reason));
+  EXPECT_EQ(ls.unregistered(), std::vector<std::string>{"rsu_1"});
+  EXPECT_TRUE(ls.registerRsu("rsu_1", &reason));
+  EXPECT_TRUE(ls.allRegistered());
+  ls.beginStep(0);
+  EXPECT_FALSE(ls.complete());
+  EXPECT_EQ(ls.onAnswer("rsu_1", 0), Lockstep::Answer::kAccepted);
+  EXPECT_EQ(ls.waitingFor(), std::vector<std::string>{"rsu_0"});
+  EXPECT_EQ(ls.onAnswer("rsu_0", 0), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.complete());
+  EXPECT_TRUE(ls.endStep(nullptr).empty());
+  EXPECT_EQ(ls.lateSteps(), 0u);
+}
+
+TEST(Lockstep, RejectsUnknownStaleAndDuplicateAnswers) {
+  Lockstep ls({"rsu_0"}, 3);
+  std::string reason;
+  EXPECT_FALSE(ls.registerRsu("rsu_9", &reason));
+  EXPECT_NE(reason.find("rsu_9"), std::string::npos);
+  ls.registerRsu("rsu_0", &reason);
+  ls.beginStep(5);
+  EXPECT_EQ(ls.onAnswer("rsu_9", 5), Lockstep::Answer::kUnknownRsu);
+  EXPECT_EQ(ls.onAnswer("rsu_0", 4), Lockstep::Answer::kStale);
+  EXPECT_EQ(ls.lateAnswers("rsu_0"), 1u);
+  EXPECT_FALSE(ls.complete());
+  EXPECT_EQ(ls.onAnswer("rsu_0", 5), Lockstep::Answer::kAccepted);
+  EXPECT_EQ(ls.onAnswer("rsu_0", 5), Lockstep::Answer::kDuplicate);
+}
+
+TEST(Lockstep, LateRsuIsCountedThenLostThenRevived) {
+  Lockstep ls({"rsu_0", "rsu_1"}, 2);
+  std::string reason;
+  ls.registerRsu("rsu_0", &reason);
+  ls.registerRsu("rsu_1", &reason);
+  std::vector<std::string> lost;
+  // Step 0: rsu_1 misses its deadline (1st miss): late, still live.
+  ls.beginStep(0);
+  ls.onAnswer("rsu_0", 0);
+  EXPECT_EQ(ls.endStep(&lost), std::vector<std::string>{"rsu_1"});
+  EXPECT_TRUE(lost.empty());
+  EXPECT_TRUE(ls.isLive("rsu_1"));
+  // Step 1: 2nd consecutive miss -> lost; no longer waited for.
+  ls.beginStep(1);
+  ls.onAnswer("rsu_0", 1);
+  ls.endStep(&lost);
+  EXPECT_EQ(lost, std::vector<std::string>{"rsu_1"});
+  EXPECT_FALSE(ls.isLive("rsu_1"));
+  EXPECT_EQ(ls.lateSteps(), 2u);
+  ls.beginStep(2);
+  ls.onAnswer("rsu_0", 2);
+  EXPECT_TRUE(ls.complete());  // the lost RSU is not waited for
+  lost.clear();
+  EXPECT_TRUE(ls.endStep(&lost).empty());
+  EXPECT_EQ(ls.lateSteps(), 2u);
+  // Step 3: it answers again and is live once more.
+  ls.beginStep(3);
+  EXPECT_EQ(ls.onAnswer("rsu_1", 3), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.isLive("rsu_1"));
+  EXPECT_FALSE(ls.complete());  // now rsu_0 is waited for
+}
+
+TEST(Lockstep, NoRsusMeansNoLockstep) {
+  Lockstep ls({}, 1);
+  EXPECT_FALSE(ls.enabled());
+  EXPECT_TRUE(ls.allRegistered());
+  ls.beginStep(0);
+  EXPECT_TRUE(ls.complete());
+}
+
+TEST(Lockstep, RejectsBadConfiguration) {
+  EXPECT_THROW(Lockstep({"a", "a"}, 1), std::invalid_argument);
+  EXPECT_THROW(Lockstep({""}, 1), std::invalid_argument);
+  EXPECT_THROW(Lockstep({"a"}, 0), std::invalid_argument);
+}

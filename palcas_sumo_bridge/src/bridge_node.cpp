@@ -1,0 +1,320 @@
+#include "palcas_sumo_bridge/bridge_node.h"
+
+#include <palcas_core/advisory_validator.h>
+#include <palcas_msgs/AdvisoryRejection.h>
+#include <palcas_msgs/EpisodeMetrics.h>
+#include <palcas_msgs/VehicleEventArray.h>
+#include <rosgraph_msgs/Clock.h>
+#include <ros/callback_queue.h>
+#include <tf2_msgs/TFMessage.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <cmath>
+#include <thread>
+
+#include "palcas_sumo_bridge/msg_conversion.h"
+#include "palcas_sumo_bridge/run_files.h"
+#include "palcas_sumo_bridge/topics.h"
+
+namespace palcas::bridge {
+namespace {
+
+MeasureRules measureRules(const BridgeOptions& o, const sim::RoadLayout& road) {
+  MeasureRules rules;
+  for (const sim::ClusterInfo& c : road.clusters())
+    rules.tracker.exit_x_m.push_back(c.off_ramp_edge.empty() ? road.mainlineLengthM() : c.exit_x_m);
+  rules.tracker.miss_margin_m = o.exit_miss_margin_m;
+  rules.tracker.stop_speed_mps = o.merge_stop_speed_mps;
+  rules.tracker.stop_window_m = o.merge_stop_window_m;
+  rules.metrics.comfort_accel_mps2 = o.comfort_threshold_mps2;
+  return rules;
+}
+
+}  // namespace
+
+BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh), private_nh_(private_nh), options_(loadBridgeOptions(private_nh_)),
+      sumocfg_path_(prepareScenario(options_)),
+      session_(std::make_unique<sim::SumoSession>(sessionOptionsFor(options_, sumocfg_path_))),
+      lockstep_(std::make_unique<sim::Lockstep>(options_.expected_rsus,
+                                                options_.lost_after_missed_steps)),
+      markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road())),
+      measure_(measureRules(options_, session_->road())) {
+  completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(),
+                   measureRules(options_, session_->road()));
+  advertise();
+  advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
+                                  ros::TransportHints().tcpNoDelay());
+  register_srv_ = nh_.advertiseService(REGISTER_RSU_SERVICE, &BridgeNode::onRegister, this);
+  ROS_INFO("palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
+           session_->sumoVersion().c_str(), sim::SumoSession::apiName(), sumocfg_path_.c_str(),
+           100.0 * options_.scenario.penetration_rate, options_.scenario.seed, options_.scenario.duration_s, options_.expected_rsus.size());
+}
+
+void BridgeNode::advertise() {
+  // Deep outgoing queues: free-running, the bridge can publish thousands of steps per second
+  // on a small road, and a recorder must not lose one (the bag must reproduce the metrics).
+  states_pub_ = nh_.advertise<palcas_msgs::VehicleStateArray>(VEHICLE_STATES_TOPIC, 5000);
+  events_pub_ = nh_.advertise<palcas_msgs::VehicleEventArray>(VEHICLE_EVENTS_TOPIC, 5000);
+  metrics_pub_ = nh_.advertise<palcas_msgs::EpisodeMetrics>(EPISODE_METRICS_TOPIC, 10, true);
+  rejections_pub_ = nh_.advertise<palcas_msgs::AdvisoryRejection>(ADVISORY_REJECTIONS_TOPIC, 100);
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>(CLOCK_TOPIC, 1000);
+  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(MARKERS_TOPIC, 2, true);
+  tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>(TF_TOPIC, 10);
+  markers_pub_.publish(markers_->roadMarkers(ros::Time(0)));
+}
+
+bool BridgeNode::onRegister(palcas_msgs::RegisterRsu::Request& req,
+                            palcas_msgs::RegisterRsu::Response& res) {
+  std::string reason;
+  res.accepted = lockstep_->registerRsu(req.rsu_id, &reason);
+  res.reason = reason;
+  res.next_step = session_->stepCount();
+  if (res.accepted) ROS_INFO("palcas bridge: RSU '%s' registered", req.rsu_id.c_str());
+  else ROS_WARN("palcas bridge: refused registration: %s", reason.c_str());
+  return true;
+}
+
+bool BridgeNode::waitForPeers() {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration<double>(options_.startup_timeout_s);
+  auto ready = [&] {
+    return lockstep_->allRegistered() &&
+           states_pub_.getNumSubscribers() >= static_cast<std::uint32_t>(options_.min_subscribers);
+  };
+  // Publish the clock so nodes on sim time can start; RSUs register once subscribed.
+  rosgraph_msgs::Clock clock;
+  clock.clock = ros::Time(session_->timeS());
+  while (ros::ok() && !ready() && std::chrono::steady_clock::now() < deadline) {
+    clock_pub_.publish(clock);
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
+  }
+  if (states_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.min_subscribers))
+    ROS_WARN("palcas bridge: starting with %u of %d expected subscribers of %s after %.1f s",
+             states_pub_.getNumSubscribers(), options_.min_subscribers, VEHICLE_STATES_TOPIC,
+             options_.startup_timeout_s);
+  if (lockstep_->allRegistered()) return true;
+  std::string missing;
+  for (const std::string& id : lockstep_->unregistered()) missing += " " + id;
+  ROS_WARN("palcas bridge: starting without RSU(s)%s: not registered after %.1f s; they are "
+           "waited for once they answer",
+           missing.c_str(), options_.startup_timeout_s);
+  return false;
+}
+
+double BridgeNode::wallSeconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+}
+
+void BridgeNode::publishStep() {
+  const ros::Time stamp(session_->timeS());
+  const std::uint64_t step = session_->stepCount();
+  rosgraph_msgs::Clock clock;
+  clock.clock = stamp;
+  clock_pub_.publish(clock);
+
+  current_states_.header.stamp = stamp;
+  current_states_.header.frame_id = MAP_FRAME;
+  current_states_.step = step;
+  current_states_.step_length_s = session_->stepLengthS();
+  current_states_.num_lanes = static_cast<uint8_t>(session_->road().numMainLanes());
+  current_states_.vehicles.clear();
+  for (const sim::VehicleRecord& v : session_->vehicles()) current_states_.vehicles.push_back(toMsg(v));
+  lockstep_->beginStep(step);
+  states_pub_.publish(current_states_);
+
+  // Measure from the published state only, so a bag of the episode reproduces it.
+  const auto& sim_events = session_->lastEvents();
+  const std::vector<metrics::VehicleEvent> events = measure_.onStep(
+      current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
+  if (!events.empty()) {
+    palcas_msgs::VehicleEventArray msg;
+    msg.header.stamp = stamp;
+    msg.header.frame_id = MAP_FRAME;
+    msg.step = step;
+    for (const auto& e : events) msg.events.push_back(toMsg(e));
+    events_pub_.publish(msg);
+  }
+  if (options_.publish_tf && tf_pub_.getNumSubscribers() > 0)
+    tf_pub_.publish(markers_->transforms(stamp, session_->vehicles()));
+}
+
+void BridgeNode::onAdvisories(const palcas_msgs::AdvisoryArray::ConstPtr& msg) {
+  if (!lockstep_->enabled()) {
+    pending_.push_back(msg);  // free-running: every publisher may advise
+    return;
+  }
+  switch (lockstep_->onAnswer(msg->rsu_id, msg->step)) {
+    case sim::Lockstep::Answer::kAccepted:
+      pending_.push_back(msg);
+      break;
+    case sim::Lockstep::Answer::kStale:
+      // Too late for lockstep, but the validator decides whether its age is acceptable.
+      pending_.push_back(msg);
+      break;
+    case sim::Lockstep::Answer::kDuplicate:
+      ROS_WARN_THROTTLE(5.0, "palcas bridge: second answer of RSU '%s' for step %lu ignored",
+                        msg->rsu_id.c_str(), static_cast<unsigned long>(msg->step));
+      break;
+    case sim::Lockstep::Answer::kUnknownRsu:
+      ROS_WARN_THROTTLE(5.0, "palcas bridge: advisories from unknown RSU '%s' ignored "
+                        "(not in ~expected_rsus)", msg->rsu_id.c_str());
+      break;
+  }
+}
+
+void BridgeNode::waitForAdvisories() {
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration<double>(options_.lockstep_deadline_s);
+  ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+  queue->callAvailable();
+  while (ros::ok() && !lockstep_->complete() && std::chrono::steady_clock::now() < deadline)
+    queue->callAvailable(ros::WallDuration(0.0005));
+  std::vector<std::string> newly_lost;
+  const std::vector<std::string> late = lockstep_->endStep(&newly_lost);
+  if (!late.empty()) {
+    measure_.metrics().addLateRsuStep();
+    std::string names;
+    for (const std::string& id : late) {
+      names += " " + id;
+      ++late_by_rsu_[id];
+    }
+    ROS_WARN_THROTTLE(5.0, "palcas bridge: step %lu: RSU(s)%s missed the %.3f s deadline; their "
+                      "CAVs keep their speed (%lu late steps so far)",
+                      static_cast<unsigned long>(session_->stepCount()), names.c_str(),
+                      options_.lockstep_deadline_s,
+                      static_cast<unsigned long>(lockstep_->lateSteps()));
+  }
+  for (const std::string& id : newly_lost)
+    ROS_ERROR("palcas bridge: RSU '%s' lost after %d missed steps; continuing without it until "
+              "it answers again", id.c_str(), options_.lost_after_missed_steps);
+}
+
+void BridgeNode::reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
+                        const std::string& detail) {
+  measure_.metrics().addAdvisoryRejected(static_cast<metrics::RejectionReason>(reason));
+  palcas_msgs::AdvisoryRejection r;
+  r.header.stamp = ros::Time(session_->timeS());
+  r.step = session_->stepCount();
+  r.rsu_id = rsu_id;
+  r.vehicle_id = vehicle_id;
+  r.reason = static_cast<uint8_t>(reason);
+  r.detail = detail;
+  rejections_pub_.publish(r);
+  ROS_WARN_THROTTLE(2.0, "palcas bridge: rejected advisory from '%s' for '%s': %s (%s)",
+                    rsu_id.c_str(), vehicle_id.c_str(),
+                    metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(reason)).c_str(),
+                    detail.c_str());
+}
+
+void BridgeNode::applyAdvisories() {
+  ros::getGlobalCallbackQueue()->callAvailable();
+  metrics::AdvisoryLimits limits;
+  limits.max_step_age = static_cast<std::uint64_t>(options_.max_advisory_age_steps);
+  const std::uint64_t step = session_->stepCount();
+  const int lanes = session_->road().numMainLanes();
+  std::unordered_set<std::string> advised;
+  std::vector<std::pair<std::string, int>> advised_actions;
+  for (const auto& array : pending_) {
+    for (const auto& a : array->advisories) {
+      const metrics::AdvisoryRequest request = toRequest(a, array->step, array->rsu_id);
+      const sim::VehicleRecord* vehicle = session_->find(a.vehicle_id);
+      const metrics::AdvisoryVerdict verdict = metrics::validateAdvisory(
+          request, step, toKnownVehicle(vehicle, lanes), limits, advised);
+      if (!verdict.accepted) {
+        reject(array->rsu_id, a.vehicle_id, static_cast<int>(verdict.reason), verdict.detail);
+        continue;
+      }
+      try {
+        session_->applyAdvisory(a.vehicle_id, a.action, a.accel_mps2);
+      } catch (const std::invalid_argument& e) {
+        // The validator and the road disagree (e.g. a lane that ends here): refuse, go on.
+        reject(array->rsu_id, a.vehicle_id, palcas_msgs::AdvisoryRejection::NO_SUCH_LANE, e.what());
+        continue;
+      }
+      advised.insert(a.vehicle_id);
+      advised_actions.emplace_back(a.vehicle_id, a.action);
+      controlled_.insert(a.vehicle_id);
+      measure_.metrics().addAdvisoriesApplied();
+    }
+  }
+  pending_.clear();
+  // Controlled CAVs without a fresh advisory (late RSU, or none sent) keep their speed.
+  for (auto it = controlled_.begin(); it != controlled_.end();) {
+    if (!session_->find(*it)) {
+      it = controlled_.erase(it);
+      continue;
+    }
+    if (!advised.count(*it)) session_->holdSpeed(*it);
+    ++it;
+  }
+  const std::uint64_t k = session_->stepCount();
+  if (k % static_cast<std::uint64_t>(options_.markers_every_steps) == 0 &&
+      markers_pub_.getNumSubscribers() > 0)
+    markers_pub_.publish(markers_->dynamicMarkers(ros::Time(session_->timeS()),
+                                                  session_->vehicles(), advised_actions));
+}
+
+void BridgeNode::publishMetrics() {
+  palcas_msgs::EpisodeMetrics msg = toMsg(measure_.metrics().snapshot(), wallSeconds());
+  msg.header.stamp = ros::Time(session_->timeS());
+  msg.step = session_->stepCount();
+  metrics_pub_.publish(msg);
+  const double left_s = msg.real_time_factor > 0.0
+                            ? (options_.scenario.duration_s - msg.sim_seconds) / msg.real_time_factor
+                            : 0.0;
+  ROS_INFO("palcas bridge: t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
+           "DSR %5.1f%%  MSR %5.1f%%  RTF %5.1fx  ~%.0f s left",
+           msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
+           msg.efficiency_cav_mps, msg.collision_rate_pct, msg.dsr_pct, msg.msr_pct,
+           msg.real_time_factor, left_s);
+}
+
+int BridgeNode::run() {
+  waitForPeers();
+  wall_start_ = std::chrono::steady_clock::now();
+  next_metrics_s_ = options_.metrics_period_s;
+  StepTimer timer;
+  publishStep();
+  while (ros::ok() && session_->timeS() < options_.scenario.duration_s - 1e-9) {
+    if (lockstep_->enabled()) waitForAdvisories();
+    applyAdvisories();
+    const auto t0 = std::chrono::steady_clock::now();
+    session_->step();
+    const auto t1 = std::chrono::steady_clock::now();
+    publishStep();
+    const auto t2 = std::chrono::steady_clock::now();
+    timer.add(session_->vehicles().size(), std::chrono::duration<double>(t1 - t0).count(),
+              std::chrono::duration<double>(t2 - t1).count());
+    if (session_->timeS() >= next_metrics_s_ - 1e-9) {
+      publishMetrics();
+      next_metrics_s_ += options_.metrics_period_s;
+    }
+    if (options_.real_time_factor > 0.0) {
+      const double due_s = session_->timeS() / options_.real_time_factor;
+      const double ahead_s = due_s - wallSeconds();
+      if (ahead_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(ahead_s));
+    }
+  }
+  if (std::abs(session_->timeS() - (next_metrics_s_ - options_.metrics_period_s)) > 1e-9)
+    publishMetrics();  // the final state, unless the periodic report just covered it
+  RunSummary summary;
+  summary.metrics = measure_.metrics().snapshot();
+  summary.wall_seconds = wallSeconds();
+  summary.steps = session_->stepCount();
+  summary.late_by_rsu = late_by_rsu_;
+  for (int r = 0; r < metrics::REJECTION_REASON_COUNT; ++r)
+    summary.rejections_by_reason[metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(r))] =
+        measure_.metrics().rejections(static_cast<metrics::RejectionReason>(r));
+  summary.timing = timer;
+  writeMetricsJson(options_, summary);
+  ROS_INFO("palcas bridge: episode done: %.0f s simulated in %.1f s; results in %s",
+           session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());
+  // Stay up a moment: recorders and RSUs still have the last messages in flight.
+  const auto linger_end = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.linger_s);
+  while (ros::ok() && std::chrono::steady_clock::now() < linger_end)
+    ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
+  return 0;
+}
+
+}  // namespace palcas::bridge

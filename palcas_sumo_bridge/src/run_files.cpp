@@ -1,0 +1,208 @@
+#include "palcas_sumo_bridge/run_files.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace palcas::bridge {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+/// FNV-1a 64: a short, stable fingerprint of the configuration snapshot.
+std::string fingerprint(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+void writeAtomically(const std::string& path, const json& content) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
+    out << content.dump(2) << "\n";
+    if (!out) throw std::runtime_error("write to '" + tmp + "' failed");
+  }
+  fs::rename(tmp, path);
+}
+
+json twoPoint(const sim::TwoPointSpeed& s) {
+  return {{"fast_mps", s.fast_mps}, {"slow_mps", s.slow_mps}, {"p_fast", s.p_fast}};
+}
+
+json insertion(const sim::InsertionSettings& i) {
+  return {{"depart_lane", i.depart_lane}, {"depart_pos", i.depart_pos}, {"depart_speed", i.depart_speed}};
+}
+
+json scenarioJson(const sim::ScenarioConfig& c) {
+  json shares = json::object();
+  for (const auto& [source, dest] : c.route_shares) shares[source] = dest;
+  return {{"scenario_dir", c.scenario_dir},
+          {"cluster_length_m", c.cluster_length_m},
+          {"penetration_rate", c.penetration_rate},
+          {"seed", c.seed},
+          {"duration_s", c.duration_s},
+          {"mainline_flow_vphpl", c.mainline_flow_vphpl},
+          {"onramp_flow_vphpl", c.onramp_flow_vphpl},
+          {"route_shares", shares},
+          {"cav_speed", twoPoint(c.cav_speed)},
+          {"hdv_speed", twoPoint(c.hdv_speed)},
+          {"mainline_insertion", insertion(c.mainline_insertion)},
+          {"onramp_insertion", insertion(c.onramp_insertion)},
+          {"max_depart_delay_s", c.max_depart_delay_s},
+          {"time_to_teleport_s", c.time_to_teleport_s},
+          {"step_length_s", c.step_length_s},
+          {"lateral_resolution_m", c.lateral_resolution_m}};
+}
+
+json bridgeJson(const BridgeOptions& o) {
+  return {{"advisory_control", o.session.advisory_control},
+          {"cav_speed_mode", o.session.cav_speed_mode},
+          {"cav_lane_change_mode", o.session.cav_lane_change_mode},
+          {"lane_change_duration_s", o.session.lane_change_duration_s},
+          {"expected_rsus", o.expected_rsus},
+          {"lockstep_deadline_s", o.lockstep_deadline_s},
+          {"lost_after_missed_steps", o.lost_after_missed_steps},
+          {"max_advisory_age_steps", o.max_advisory_age_steps},
+          {"real_time_factor", o.real_time_factor},
+          {"exit_miss_margin_m", o.exit_miss_margin_m},
+          {"merge_stop_speed_mps", o.merge_stop_speed_mps},
+          {"merge_stop_window_m", o.merge_stop_window_m},
+          {"comfort_threshold_mps2", o.comfort_threshold_mps2},
+          {"gui", o.gui},
+          {"sumo_warnings", o.sumo_warnings}};
+}
+
+}  // namespace
+
+void StepTimer::add(std::size_t vehicles, double sumo_s, double bridge_s) {
+  Bucket& b = buckets_[vehicles / BUCKET_WIDTH * BUCKET_WIDTH];
+  ++b.steps;
+  b.sumo_s += sumo_s;
+  b.bridge_s += bridge_s;
+}
+
+std::string prepareScenario(const BridgeOptions& o) {
+  const sim::ScenarioConfig& config = o.scenario;
+  fs::create_directories(o.out_dir);
+  const sim::ScenarioFiles files = sim::writeScenario(config, o.out_dir + "/scenario");
+  json snapshot = {{"scenario", scenarioJson(config)}, {"bridge", bridgeJson(o)}};
+  json manifest = {{"config", snapshot},
+                   {"config_hash", fingerprint(snapshot.dump())},
+                   {"seeds", {{"sumo", config.seed}}},
+                   {"pr_percent", 100.0 * config.penetration_rate},
+                   {"duration_s", config.duration_s},
+                   {"git_commit", o.git_commit},
+                   {"command_line", o.command_line},
+                   {"sumocfg", files.sumocfg_file}};
+  writeAtomically(o.out_dir + "/manifest.json", manifest);
+  return files.sumocfg_file;
+}
+
+void completeManifest(const BridgeOptions& o, const std::string& sumo_version,
+                      const std::string& api_name, const MeasureRules& rules) {
+  const std::string path = o.out_dir + "/manifest.json";
+  std::ifstream in(path);
+  json manifest = json::parse(in);
+  manifest["sumo_version"] = sumo_version;
+  manifest["sumo_api"] = api_name;
+  manifest["measure_rules"] = {{"exit_x_m", rules.tracker.exit_x_m},
+                               {"miss_margin_m", rules.tracker.miss_margin_m},
+                               {"stop_speed_mps", rules.tracker.stop_speed_mps},
+                               {"stop_window_m", rules.tracker.stop_window_m},
+                               {"comfort_accel_mps2", rules.metrics.comfort_accel_mps2}};
+  writeAtomically(path, manifest);
+}
+
+MeasureRules readMeasureRules(const std::string& manifest_path) {
+  std::ifstream in(manifest_path);
+  if (!in) throw std::runtime_error("cannot read '" + manifest_path + "'");
+  json manifest;
+  try {
+    manifest = json::parse(in);
+  } catch (const json::exception& e) {
+    throw std::runtime_error("'" + manifest_path + "' is not JSON: " + e.what());
+  }
+  if (!manifest.contains("measure_rules"))
+    throw std::runtime_error("'" + manifest_path + "' is not a PALCAS run manifest (no measure_rules)");
+  const json& r = manifest["measure_rules"];
+  MeasureRules rules;
+  try {
+    rules.tracker.exit_x_m = r.at("exit_x_m").get<std::vector<double>>();
+    rules.tracker.miss_margin_m = r.at("miss_margin_m").get<double>();
+    rules.tracker.stop_speed_mps = r.at("stop_speed_mps").get<double>();
+    rules.tracker.stop_window_m = r.at("stop_window_m").get<double>();
+    rules.metrics.comfort_accel_mps2 = r.at("comfort_accel_mps2").get<double>();
+  } catch (const json::exception& e) {
+    throw std::runtime_error("'" + manifest_path + "': measure_rules incomplete: " + e.what());
+  }
+  return rules;
+}
+
+sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg) {
+  sim::SessionOptions s = o.session;
+  // Teleports end a vehicle's trip (counted apart from collisions), so its outcome is decided.
+  s.sumo_args = {"-c", sumocfg, "--time-to-teleport.remove", "true", "--no-step-log", "true",
+                 "--duration-log.disable", "true"};
+  // SUMO prints a warning for every emergency braking; off by default so progress stays
+  // readable, on demand into the run folder (and the console).
+  if (o.sumo_warnings) s.sumo_args.insert(s.sumo_args.end(), {"--log", o.out_dir + "/sumo.log"});
+  else s.sumo_args.insert(s.sumo_args.end(), {"--no-warnings", "true"});
+  s.sumo_binary = o.gui ? "sumo-gui" : "sumo";
+  if (o.gui) s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", "true"});
+  return s;
+}
+
+void writeMetricsJson(const BridgeOptions& o, const RunSummary& s) {
+  const metrics::EpisodeMetrics& m = s.metrics;
+  json timing = json::array();
+  for (const auto& [first, b] : s.timing.buckets())
+    timing.push_back({{"vehicles_from", first},
+                      {"vehicles_to", first + StepTimer::BUCKET_WIDTH - 1},
+                      {"steps", b.steps},
+                      {"sumo_ms_per_step", 1e3 * b.sumo_s / b.steps},
+                      {"bridge_ms_per_step", 1e3 * b.bridge_s / b.steps}});
+  json out = {{"efficiency_all_mps", number(m.efficiency_all_mps)},
+              {"efficiency_cav_mps", number(m.efficiency_cav_mps)},
+              {"collision_rate_pct", number(m.collision_rate_pct)},
+              {"dsr_pct", number(m.dsr_pct)},
+              {"msr_pct", number(m.msr_pct)},
+              {"comfort_share_pct", number(m.comfort_share_pct)},
+              {"collisions", m.collisions},
+              {"cav_collisions", m.cav_collisions},
+              {"teleports", m.teleports},
+              {"cavs_seen", m.cavs_seen},
+              {"exiting_cavs", m.exiting_cavs},
+              {"exits_ok", m.exits_ok},
+              {"exits_missed", m.exits_missed},
+              {"merging_cavs", m.merging_cavs},
+              {"merges_ok", m.merges_ok},
+              {"advisories", m.advisories_applied},
+              {"advisories_rejected", m.advisories_rejected},
+              {"rejections_by_reason", s.rejections_by_reason},
+              {"late_rsu_steps", m.late_rsu_steps},
+              {"late_steps_by_rsu", s.late_by_rsu},
+              {"sim_seconds", m.sim_seconds},
+              {"wall_seconds", s.wall_seconds},
+              {"real_time_factor", number(s.wall_seconds > 0 ? m.sim_seconds / s.wall_seconds : NAN)},
+              {"steps", s.steps},
+              {"pr_percent", 100.0 * o.scenario.penetration_rate},
+              {"seed", o.scenario.seed},
+              {"step_timing", timing}};
+  writeAtomically(o.out_dir + "/metrics.json", out);
+}
+
+}  // namespace palcas::bridge
