@@ -1,0 +1,1 @@
+# federation_sources (filled by its area)

@@ -1,0 +1,1 @@
+# federation_tests (filled by its area)

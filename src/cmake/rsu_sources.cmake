@@ -1,0 +1,1 @@
+# rsu_sources (filled by its area)

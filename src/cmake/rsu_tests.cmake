@@ -1,0 +1,1 @@
+# rsu_tests (filled by its area)
