@@ -172,6 +172,8 @@ void BridgeNode::waitForAdvisories() {
     queue->callAvailable(ros::WallDuration(0.0005));
   std::vector<std::string> newly_lost;
   const std::vector<std::string> late = lockstep_->endStep(&newly_lost);
+  late_this_step_ = std::unordered_set<std::string>(late.begin(), late.end());
+  for (const std::string& id : lockstep_->lostRsus()) late_this_step_.insert(id);
   if (!late.empty()) {
     measure_.metrics().addLateRsuStep();
     std::string names;
@@ -234,20 +236,25 @@ void BridgeNode::applyAdvisories() {
       }
       advised.insert(a.vehicle_id);
       advised_actions.emplace_back(a.vehicle_id, a.action);
-      controlled_.insert(a.vehicle_id);
+      controlled_[a.vehicle_id] = Control{array->rsu_id, step};
       measure_.metrics().addAdvisoriesApplied();
     }
   }
   pending_.clear();
-  // Controlled CAVs without a fresh advisory (late RSU, or none sent) keep their speed.
+  // Without a fresh advisory a CAV holds its command until it expires; if its RSU is late
+  // (or lost) it keeps its speed at once.
+  const auto hold = static_cast<std::uint64_t>(options_.advisory_hold_steps);
   for (auto it = controlled_.begin(); it != controlled_.end();) {
-    if (!session_->find(*it)) {
+    if (!session_->find(it->first)) {
       it = controlled_.erase(it);
       continue;
     }
-    if (!advised.count(*it)) session_->holdSpeed(*it);
+    if (!advised.count(it->first) &&
+        (late_this_step_.count(it->second.rsu_id) || step >= it->second.step + hold))
+      session_->holdSpeed(it->first);
     ++it;
   }
+  late_this_step_.clear();
   const std::uint64_t k = session_->stepCount();
   if (k % static_cast<std::uint64_t>(options_.markers_every_steps) == 0 &&
       markers_pub_.getNumSubscribers() > 0)

@@ -142,6 +142,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
   o.min_subscribers = p.getInt("min_subscribers", o.min_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.getInt("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.getInt("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
+  o.advisory_hold_steps = p.getInt("advisory_hold_steps", o.advisory_hold_steps, 1, 1000000);
   o.real_time_factor = p.getDouble("real_time_factor", o.real_time_factor, 0.0, 1000.0);
   o.metrics_period_s = p.getDouble("metrics_period", o.metrics_period_s, 0.1, 1e6);
   o.linger_s = p.getDouble("linger", o.linger_s, 0.0, 60.0);

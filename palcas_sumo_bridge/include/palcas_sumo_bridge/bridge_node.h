@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -67,8 +68,14 @@ class BridgeNode {
   palcas_msgs::VehicleStateArray current_states_;
   /// Advisory arrays received for the open step, by RSU, in arrival order.
   std::vector<palcas_msgs::AdvisoryArray::ConstPtr> pending_;
-  /// CAVs that have been advised at least once: without a fresh advisory they hold speed.
-  std::unordered_set<std::string> controlled_;
+  /// Who advised a CAV last and at which step: its command holds for advisory_hold_steps,
+  /// unless that RSU is late, then the CAV keeps its speed.
+  struct Control {
+    std::string rsu_id;
+    std::uint64_t step = 0;
+  };
+  std::unordered_map<std::string, Control> controlled_;
+  std::unordered_set<std::string> late_this_step_;
   std::map<std::string, std::uint64_t> late_by_rsu_;
   std::chrono::steady_clock::time_point wall_start_;
   double next_metrics_s_ = 0.0;

@@ -31,6 +31,9 @@ struct BridgeOptions {
   int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
   int lost_after_missed_steps = 50;        ///< consecutive misses before an RSU is lost
   int max_advisory_age_steps = 0;          ///< 0 = an advisory must answer the current step
+  /// An applied advisory holds this many steps; then, without a new one, the CAV keeps its
+  /// speed. CAVs of an RSU that misses a step's deadline keep their speed at once.
+  int advisory_hold_steps = 10;
   // Pace and outputs.
   double real_time_factor = 0.0;   ///< 0 = as fast as possible; e.g. 1.0 = real time
   double metrics_period_s = 10.0;  ///< simulated time between EpisodeMetrics messages [s]

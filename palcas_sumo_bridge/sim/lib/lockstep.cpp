@@ -97,6 +97,13 @@ bool Lockstep::isLive(const std::string& rsu_id) const {
   return it != rsus_.end() && it->second.registered && !it->second.lost;
 }
 
+std::vector<std::string> Lockstep::lostRsus() const {
+  std::vector<std::string> out;
+  for (const auto& [id, s] : rsus_)
+    if (s.registered && s.lost) out.push_back(id);
+  return out;
+}
+
 std::uint64_t Lockstep::lateAnswers(const std::string& rsu_id) const {
   auto it = rsus_.find(rsu_id);
   return it == rsus_.end() ? 0 : it->second.late_answers;

@@ -56,6 +56,7 @@ TEST(Lockstep, LateRsuIsCountedThenLostThenRevived) {
   ls.endStep(&lost);
   EXPECT_EQ(lost, std::vector<std::string>{"rsu_1"});
   EXPECT_FALSE(ls.isLive("rsu_1"));
+  EXPECT_EQ(ls.lostRsus(), std::vector<std::string>{"rsu_1"});
   EXPECT_EQ(ls.lateSteps(), 2u);
   ls.beginStep(2);
   ls.onAnswer("rsu_0", 2);

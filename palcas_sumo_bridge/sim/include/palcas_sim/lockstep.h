@@ -38,6 +38,8 @@ class Lockstep {
 
   bool enabled() const { return !rsus_.empty(); }
   bool isLive(const std::string& rsu_id) const;
+  /// Registered RSUs currently considered lost.
+  std::vector<std::string> lostRsus() const;
   std::uint64_t lateSteps() const { return late_steps_; }
   std::uint64_t lateAnswers(const std::string& rsu_id) const;
 

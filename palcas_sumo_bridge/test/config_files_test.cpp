@@ -1,0 +1,79 @@
+// Every shipped configuration goes through the real loader (rostest: the launch file loads
+// config/bridge.yaml and each scenario's scenario.yaml into a namespace per case), and bad
+// files are refused naming the key.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "palcas_sumo_bridge/bridge_options.h"
+
+using palcas::bridge::loadBridgeOptions;
+
+TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
+  const auto o = loadBridgeOptions(ros::NodeHandle("~paper"));
+  EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 3200.0);  // paper
+  EXPECT_DOUBLE_EQ(o.scenario.onramp_flow_vphpl, 600.0);     // paper
+  EXPECT_DOUBLE_EQ(o.scenario.cluster_length_m, 800.0);      // paper
+  EXPECT_DOUBLE_EQ(o.scenario.step_length_s, 0.1);
+  EXPECT_DOUBLE_EQ(o.scenario.lateral_resolution_m, 3.2);
+  EXPECT_DOUBLE_EQ(o.scenario.cav_speed.fast_mps, 33.528);
+  EXPECT_EQ(o.scenario.route_shares.at("main").at("end"), 0.55);
+  EXPECT_DOUBLE_EQ(o.session.cluster_length_m, 800.0);
+  EXPECT_DOUBLE_EQ(o.session.lane_change_duration_s, 2.0);  // paper
+  EXPECT_DOUBLE_EQ(o.comfort_threshold_mps2, 1.47);         // paper
+  EXPECT_EQ(o.session.cav_lane_change_mode, 256);
+  EXPECT_EQ(o.out_dir, "/tmp/palcas_config_test");
+}
+
+TEST(ConfigFiles, TinyScenarioLoads) {
+  const auto o = loadBridgeOptions(ros::NodeHandle("~tiny"));
+  EXPECT_LT(o.scenario.cluster_length_m, 800.0);
+  EXPECT_FALSE(o.scenario.route_shares.empty());
+}
+
+TEST(ConfigFiles, YamlDefaultsEqualTheStructDefaults) {
+  // A key whose YAML value drifted from the code's default would make runs without the
+  // YAML (tests, other launch files) behave differently.
+  const auto o = loadBridgeOptions(ros::NodeHandle("~paper"));
+  const palcas::bridge::BridgeOptions d;
+  EXPECT_EQ(o.session.cav_speed_mode, d.session.cav_speed_mode);
+  EXPECT_EQ(o.session.cav_lane_change_mode, d.session.cav_lane_change_mode);
+  EXPECT_DOUBLE_EQ(o.lockstep_deadline_s, d.lockstep_deadline_s);
+  EXPECT_EQ(o.lost_after_missed_steps, d.lost_after_missed_steps);
+  EXPECT_EQ(o.advisory_hold_steps, d.advisory_hold_steps);
+  EXPECT_DOUBLE_EQ(o.exit_miss_margin_m, d.exit_miss_margin_m);
+  EXPECT_DOUBLE_EQ(o.merge_stop_window_m, d.merge_stop_window_m);
+  const palcas::sim::ScenarioConfig s;
+  EXPECT_DOUBLE_EQ(o.scenario.max_depart_delay_s, s.max_depart_delay_s);
+  EXPECT_DOUBLE_EQ(o.scenario.time_to_teleport_s, s.time_to_teleport_s);
+  EXPECT_DOUBLE_EQ(o.scenario.penetration_rate, s.penetration_rate);
+}
+
+TEST(ConfigFiles, UnknownKeyIsNamed) {
+  try {
+    loadBridgeOptions(ros::NodeHandle("~typo"));
+    FAIL() << "an unknown key was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lockstep_dedline"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
+  try {
+    loadBridgeOptions(ros::NodeHandle("~wrong_type"));
+    FAIL() << "a string deadline was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("lockstep_deadline"), std::string::npos) << e.what();
+  }
+  try {
+    loadBridgeOptions(ros::NodeHandle("~out_of_range"));
+    FAIL() << "a penetration rate of 1.2 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("penetration_rate"), std::string::npos) << e.what();
+  }
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "config_files_test");
+  return RUN_ALL_TESTS();
+}
