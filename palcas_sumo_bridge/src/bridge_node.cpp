@@ -39,9 +39,9 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       lockstep_(std::make_unique<sim::Lockstep>(options_.expected_rsus,
                                                 options_.lost_after_missed_steps)),
       markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road())),
-      measure_(measureRules(options_, session_->road())) {
-  completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(),
-                   measureRules(options_, session_->road()));
+      rules_(measureRules(options_, session_->road())),
+      measure_(std::make_unique<EpisodeMeasure>(rules_)) {
+  completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(), rules_);
   advertise();
   advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
                                   ros::TransportHints().tcpNoDelay());
@@ -125,7 +125,7 @@ void BridgeNode::publishStep() {
 
   // Measure from the published state only, so a bag of the episode reproduces it.
   const auto& sim_events = session_->lastEvents();
-  const std::vector<metrics::VehicleEvent> events = measure_.onStep(
+  const std::vector<metrics::VehicleEvent> events = measure_->onStep(
       current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
   if (!events.empty()) {
     palcas_msgs::VehicleEventArray msg;
@@ -175,7 +175,7 @@ void BridgeNode::waitForAdvisories() {
   late_this_step_ = std::unordered_set<std::string>(late.begin(), late.end());
   for (const std::string& id : lockstep_->lostRsus()) late_this_step_.insert(id);
   if (!late.empty()) {
-    measure_.metrics().addLateRsuStep();
+    measure_->metrics().addLateRsuStep();
     std::string names;
     for (const std::string& id : late) {
       names += " " + id;
@@ -194,7 +194,7 @@ void BridgeNode::waitForAdvisories() {
 
 void BridgeNode::reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
                         const std::string& detail) {
-  measure_.metrics().addAdvisoryRejected(static_cast<metrics::RejectionReason>(reason));
+  measure_->metrics().addAdvisoryRejected(static_cast<metrics::RejectionReason>(reason));
   palcas_msgs::AdvisoryRejection r;
   r.header.stamp = ros::Time(session_->timeS());
   r.step = session_->stepCount();
@@ -229,15 +229,16 @@ void BridgeNode::applyAdvisories() {
       }
       try {
         session_->applyAdvisory(a.vehicle_id, a.action, a.accel_mps2);
-      } catch (const std::invalid_argument& e) {
-        // The validator and the road disagree (e.g. a lane that ends here): refuse, go on.
+      } catch (const std::exception& e) {
+        // The validator and the road disagree (e.g. a lane that ends here) or SUMO refused
+        // the command: reject it and keep the simulation running.
         reject(array->rsu_id, a.vehicle_id, palcas_msgs::AdvisoryRejection::NO_SUCH_LANE, e.what());
         continue;
       }
       advised.insert(a.vehicle_id);
       advised_actions.emplace_back(a.vehicle_id, a.action);
       controlled_[a.vehicle_id] = Control{array->rsu_id, step};
-      measure_.metrics().addAdvisoriesApplied();
+      measure_->metrics().addAdvisoriesApplied();
     }
   }
   pending_.clear();
@@ -263,27 +264,37 @@ void BridgeNode::applyAdvisories() {
 }
 
 void BridgeNode::publishMetrics() {
-  palcas_msgs::EpisodeMetrics msg = toMsg(measure_.metrics().snapshot(), wallSeconds());
+  palcas_msgs::EpisodeMetrics msg = toMsg(measure_->metrics().snapshot(), wallSeconds());
   msg.header.stamp = ros::Time(session_->timeS());
   msg.step = session_->stepCount();
   metrics_pub_.publish(msg);
-  const double left_s = msg.real_time_factor > 0.0
-                            ? (options_.scenario.duration_s - msg.sim_seconds) / msg.real_time_factor
-                            : 0.0;
-  ROS_INFO("palcas bridge: t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
+  // Time left over every remaining episode, at this episode's pace.
+  const double remaining_sim_s = options_.scenario.duration_s * (options_.episodes - episode_) - msg.sim_seconds;
+  const double left_s = msg.real_time_factor > 0.0 ? remaining_sim_s / msg.real_time_factor : 0.0;
+  ROS_INFO("palcas bridge: episode %d/%d  t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
            "DSR %5.1f%%  MSR %5.1f%%  RTF %5.1fx  ~%.0f s left",
-           msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
+           episode_ + 1, options_.episodes, msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
            msg.efficiency_cav_mps, msg.collision_rate_pct, msg.dsr_pct, msg.msr_pct,
            msg.real_time_factor, left_s);
 }
 
-int BridgeNode::run() {
-  waitForPeers();
+void BridgeNode::startEpisode(int episode) {
+  episode_ = episode;
+  session_.reset();  // closes SUMO before the next one loads (one libsumo per process)
+  session_ = std::make_unique<sim::SumoSession>(sessionOptionsFor(options_, sumocfg_path_, episode));
+  measure_ = std::make_unique<EpisodeMeasure>(rules_);
+  controlled_.clear();
+  pending_.clear();
+  late_by_rsu_.clear();
+}
+
+void BridgeNode::runEpisode(int episode) {
   wall_start_ = std::chrono::steady_clock::now();
   next_metrics_s_ = options_.metrics_period_s;
+  const double duration_s = options_.scenario.duration_s;
   StepTimer timer;
   publishStep();
-  while (ros::ok() && session_->timeS() < options_.scenario.duration_s - 1e-9) {
+  while (ros::ok() && session_->timeS() < duration_s - 1e-9) {
     if (lockstep_->enabled()) waitForAdvisories();
     applyAdvisories();
     const auto t0 = std::chrono::steady_clock::now();
@@ -306,17 +317,26 @@ int BridgeNode::run() {
   if (std::abs(session_->timeS() - (next_metrics_s_ - options_.metrics_period_s)) > 1e-9)
     publishMetrics();  // the final state, unless the periodic report just covered it
   RunSummary summary;
-  summary.metrics = measure_.metrics().snapshot();
+  summary.episode = episode;
+  summary.metrics = measure_->metrics().snapshot();
   summary.wall_seconds = wallSeconds();
   summary.steps = session_->stepCount();
   summary.late_by_rsu = late_by_rsu_;
   for (int r = 0; r < metrics::REJECTION_REASON_COUNT; ++r)
     summary.rejections_by_reason[metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(r))] =
-        measure_.metrics().rejections(static_cast<metrics::RejectionReason>(r));
+        measure_->metrics().rejections(static_cast<metrics::RejectionReason>(r));
   summary.timing = timer;
-  writeMetricsJson(options_, summary);
-  ROS_INFO("palcas bridge: episode done: %.0f s simulated in %.1f s; results in %s",
-           session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());
+  writeMetricsJson(options_, summary, episode);
+  ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
+           options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());
+}
+
+int BridgeNode::run() {
+  waitForPeers();
+  for (int episode = 0; episode < options_.episodes && ros::ok(); ++episode) {
+    if (episode > 0) startEpisode(episode);
+    runEpisode(episode);
+  }
   // Stay up a moment: recorders and RSUs still have the last messages in flight.
   const auto linger_end = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.linger_s);
   while (ros::ok() && std::chrono::steady_clock::now() < linger_end)

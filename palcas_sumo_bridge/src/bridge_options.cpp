@@ -125,6 +125,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
   sim::validateScenarioConfig(o.scenario);
   o.out_dir = p.get<std::string>("out_dir", "");
   if (o.out_dir.empty()) throw std::invalid_argument("parameter '~out_dir' is required");
+  o.episodes = p.getInt("episodes", o.episodes, 1, 1000000);
   o.command_line = p.get<std::string>("command_line", "");
   o.git_commit = p.get<std::string>("git_commit", "");
   o.gui = p.get<bool>("gui", o.gui);

@@ -152,11 +152,13 @@ MeasureRules readMeasureRules(const std::string& manifest_path) {
   return rules;
 }
 
-sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg) {
+sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg,
+                                      int episode) {
   sim::SessionOptions s = o.session;
   // Teleports end a vehicle's trip (counted apart from collisions), so its outcome is decided.
   s.sumo_args = {"-c", sumocfg, "--time-to-teleport.remove", "true", "--no-step-log", "true",
-                 "--duration-log.disable", "true"};
+                 "--duration-log.disable", "true",
+                 "--seed", std::to_string(o.scenario.seed + static_cast<unsigned>(episode))};
   // SUMO prints a warning for every emergency braking; off by default so progress stays
   // readable, on demand into the run folder (and the console).
   if (o.sumo_warnings) s.sumo_args.insert(s.sumo_args.end(), {"--log", o.out_dir + "/sumo.log"});
@@ -166,7 +168,7 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   return s;
 }
 
-void writeMetricsJson(const BridgeOptions& o, const RunSummary& s) {
+void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {
   const metrics::EpisodeMetrics& m = s.metrics;
   json timing = json::array();
   for (const auto& [first, b] : s.timing.buckets())
@@ -200,9 +202,28 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s) {
               {"real_time_factor", number(s.wall_seconds > 0 ? m.sim_seconds / s.wall_seconds : NAN)},
               {"steps", s.steps},
               {"pr_percent", 100.0 * o.scenario.penetration_rate},
-              {"seed", o.scenario.seed},
+              {"seed", o.scenario.seed + static_cast<unsigned>(episode)},
+              {"episode", episode},
+              {"episodes", o.episodes},
               {"step_timing", timing}};
   writeAtomically(o.out_dir + "/metrics.json", out);
+  if (o.episodes == 1) return;
+  const std::string dir = o.out_dir + "/episode_" + std::to_string(episode);
+  fs::create_directories(dir);
+  writeAtomically(dir + "/metrics.json", out);
+  // One row per episode, for learning curves.
+  const std::string csv = o.out_dir + "/episodes.csv";
+  const bool fresh = !fs::exists(csv);
+  std::ofstream rows(csv, std::ios::app);
+  if (fresh)
+    rows << "episode,seed,sim_seconds,wall_seconds,efficiency_all_mps,efficiency_cav_mps,"
+            "collision_rate_pct,dsr_pct,msr_pct,comfort_share_pct,cavs_seen,exiting_cavs,"
+            "merging_cavs,advisories,advisories_rejected,late_rsu_steps\n";
+  rows << episode << ',' << o.scenario.seed + static_cast<unsigned>(episode) << ',' << m.sim_seconds
+       << ',' << s.wall_seconds << ',' << m.efficiency_all_mps << ',' << m.efficiency_cav_mps << ','
+       << m.collision_rate_pct << ',' << m.dsr_pct << ',' << m.msr_pct << ',' << m.comfort_share_pct
+       << ',' << m.cavs_seen << ',' << m.exiting_cavs << ',' << m.merging_cavs << ','
+       << m.advisories_applied << ',' << m.advisories_rejected << ',' << m.late_rsu_steps << '\n';
 }
 
 }  // namespace palcas::bridge

@@ -32,8 +32,8 @@ class BridgeNode {
   /// subscribes and offers services. @throws std::exception naming what failed.
   BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
-  /// Runs the episode to its duration (or until ROS shuts down), then writes metrics.json.
-  /// @return the process exit code.
+  /// Runs every episode to its duration (or until ROS shuts down), writing each one's
+  /// metrics. @return the process exit code.
   int run();
 
  private:
@@ -41,6 +41,9 @@ class BridgeNode {
   /// Start handshake: every expected RSU registered and ~min_subscribers listening, or
   /// the startup timeout. @return false when some RSU did not register.
   bool waitForPeers();
+  /// Episode k >= 1: SUMO reloaded with seed + k, measuring and advisory state reset.
+  void startEpisode(int episode);
+  void runEpisode(int episode);
   void publishStep();
   void waitForAdvisories();
   void applyAdvisories();
@@ -58,7 +61,9 @@ class BridgeNode {
   std::unique_ptr<sim::SumoSession> session_;
   std::unique_ptr<sim::Lockstep> lockstep_;
   std::unique_ptr<RvizMarkers> markers_;
-  EpisodeMeasure measure_;
+  MeasureRules rules_;
+  std::unique_ptr<EpisodeMeasure> measure_;
+  int episode_ = 0;
 
   ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,
       markers_pub_, tf_pub_;

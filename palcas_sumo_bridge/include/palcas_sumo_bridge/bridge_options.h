@@ -18,6 +18,7 @@ struct BridgeOptions {
   // demand, PR, seed, duration and cluster length; ~scenario_dir overrides its folder.
   sim::ScenarioConfig scenario;
   std::string out_dir;             ///< run folder: generated scenario, metrics.json, manifest.json
+  int episodes = 1;                ///< episodes in this run; episode k uses SUMO seed + k
   std::string command_line;        ///< how the run was started, for the manifest
   std::string git_commit;          ///< for the manifest
   // SUMO.

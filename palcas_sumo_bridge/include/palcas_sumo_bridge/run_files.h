@@ -34,6 +34,7 @@ class StepTimer {
 };
 
 struct RunSummary {
+  int episode = 0;
   metrics::EpisodeMetrics metrics;
   double wall_seconds = 0.0;
   std::uint64_t steps = 0;
@@ -46,8 +47,9 @@ struct RunSummary {
 /// @return the .sumocfg path. @throws std::exception naming what failed.
 std::string prepareScenario(const BridgeOptions& options);
 
-/// SUMO session options for a generated scenario.
-sim::SessionOptions sessionOptionsFor(const BridgeOptions& options, const std::string& sumocfg);
+/// SUMO session options for a generated scenario; episode k runs with SUMO seed + k.
+sim::SessionOptions sessionOptionsFor(const BridgeOptions& options, const std::string& sumocfg,
+                                      int episode = 0);
 
 /// Adds the SUMO version, API and the measuring rules (exit positions, thresholds, which
 /// metrics_from_bag needs) to <out_dir>/manifest.json once SUMO runs.
@@ -58,7 +60,9 @@ void completeManifest(const BridgeOptions& options, const std::string& sumo_vers
 /// is missing when the file is not a PALCAS manifest.
 MeasureRules readMeasureRules(const std::string& manifest_path);
 
-/// Writes <out_dir>/metrics.json atomically (NaN as null).
-void writeMetricsJson(const BridgeOptions& options, const RunSummary& summary);
+/// Writes the episode's metrics atomically (NaN as null) to <out_dir>/metrics.json; with
+/// several episodes also to <out_dir>/episode_<k>/metrics.json and a row of
+/// <out_dir>/episodes.csv.
+void writeMetricsJson(const BridgeOptions& options, const RunSummary& summary, int episode);
 
 }  // namespace palcas::bridge

@@ -297,7 +297,9 @@ void SumoSession::manageExit(VehicleRecord& v) {
   // leaves lane 1 (the off-ramp only connects from lane 1).
   const bool in_exit_lane = v.lane == 1;
   if (in_exit_lane && !v.exit_committed) {
-    api::Vehicle::changeTarget(v.id, road_->clusters()[v.exit_cluster].off_ramp_edge);
+    // An explicit two-edge route: SUMO's router (changeTarget) finds no route to the
+    // dead-end ramp edge, but the direct connection from lane 1 exists.
+    api::Vehicle::setRoute(v.id, std::vector<std::string>{v.edge, road_->clusters()[v.exit_cluster].off_ramp_edge});
     v.exit_committed = true;
   } else if (!in_exit_lane && v.exit_committed) {
     api::Vehicle::changeTarget(v.id, end_edge_);
@@ -330,12 +332,16 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
   VehicleRecord& v = vehicles_[it->second];
   if (action == LANE_LEFT || action == LANE_RIGHT) {
     const int target_lane = action == LANE_LEFT ? v.lane + 1 : v.lane - 1;
-    if (road_->sumoLaneIndex(v.edge, target_lane) < 0)
+    const bool on_junction = !road_->hasEdge(v.edge);
+    if (!on_junction && road_->sumoLaneIndex(v.edge, target_lane) < 0)
       throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
                                   "' has no lane " + std::to_string(target_lane));
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
-    requestLaneChange(v, options_.lane_change_duration_s);
+    // On a junction's internal lane (a fraction of a metre) the request waits for the next
+    // edge: continueLaneChange issues it there.
+    v.lane_change_edge.clear();
+    if (!on_junction) requestLaneChange(v, options_.lane_change_duration_s);
     v.command = HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;
   } else if (action == ACCELERATE) {
