@@ -7,6 +7,7 @@ list(APPEND PALCAS_CORE_SOURCES
   lib/nn/batch_norm.cpp
   lib/nn/dropout.cpp
   lib/nn/network.cpp
+  lib/nn/folded_network.cpp
   lib/nn/huber_loss.cpp
   lib/nn/adamw.cpp
   lib/nn/serialization.cpp

@@ -104,9 +104,12 @@ void PdqnAgent::selectQ(const nn::Matrix& q_out, nn::Index n, nn::Matrix& out) c
 void PdqnAgent::forwardGreedy(const nn::Matrix& states) {
   mu_.eval();
   q_.eval();
-  act_c_ = mu_.forward(states);
+  // The folds equal the eval-mode networks within float rounding (folded_network_test).
+  mu_fold_.refresh(mu_);
+  q_fold_.refresh(q_);
+  act_c_ = mu_fold_.forward(states);
   buildQInput(states, act_c_, act_q_in_);
-  selectQ(q_.forward(act_q_in_), states.cols(), act_q_);
+  selectQ(q_fold_.forward(act_q_in_), states.cols(), act_q_);
 }
 
 void PdqnAgent::act(const nn::Matrix& states, bool explore, std::vector<Decision>& out) {
@@ -181,9 +184,12 @@ float PdqnAgent::updateQ() {
   const nn::Index n = config_.batch_size;
   const nn::Index passes = config_.multi_pass ? ACTION_COUNT : 1;
   // y = r + gamma (1 - done) max_a' Q_target(s', mu_target(s'))_a'   (P-DQN TD target)
-  c_norm_ = mu_target_.forward(batch_.next_states);
+  // Targets are in eval mode and change every C steps only: their folds are reused.
+  mu_target_fold_.refresh(mu_target_);
+  q_target_fold_.refresh(q_target_);
+  c_norm_ = mu_target_fold_.forward(batch_.next_states);
   buildQInput(batch_.next_states, c_norm_, q_in_);
-  selectQ(q_target_.forward(q_in_), n, q_sel_);
+  selectQ(q_target_fold_.forward(q_in_), n, q_sel_);
   target_y_ = batch_.rewards.array() + config_.gamma * (1.0f - batch_.dones.array()) *
                                            q_sel_.colwise().maxCoeff().array();
   // Prediction Q_phi(s, c)_a with the stored (executed) parameter.

@@ -315,3 +315,43 @@ TEST(PdqnAgent, LoadCheckpointRefusesOtherFilesUnchanged) {
   EXPECT_EQ(agent.exportModel().values, before);
   std::remove(path.c_str());
 }
+
+// act()/evaluate() run on folded copies of the networks (batch norm folded into the
+// Linears); they must follow every change of the online networks.
+TEST(PdqnAgent, DecisionsFollowUpdatesImportsAndCheckpoints) {
+  const std::string path = tempPath("fold_checkpoint.palcas");
+  PdqnAgent agent(smallConfig(31));
+  Rng data(12);
+  const Matrix states = randomStates(5, 6, data);
+  auto expectLayered = [&](PdqnAgent& a) {
+    Matrix q, accel;
+    a.evaluate(states, q, accel);
+    nn::Network mu = a.paramNetwork(), qnet = a.qNetwork();
+    mu.eval();
+    qnet.eval();
+    const Matrix c_norm = mu.forward(states);
+    Matrix q_in(6, 6);
+    q_in << states, c_norm;
+    const Matrix q_layered = qnet.forward(q_in);
+    for (Index j = 0; j < 6; ++j) {
+      // a = -0.95 + 3.55 c_n (see QIsTheQNetworkOnStateAndNormalisedParameter)
+      EXPECT_NEAR(accel(0, j), -0.95f + 3.55f * c_norm(0, j), 1e-5f);
+      for (Index i = 0; i < 4; ++i) EXPECT_NEAR(q(i, j), q_layered(i, j), 1e-5f);
+    }
+  };
+  expectLayered(agent);
+  fillReplay(agent, 64, 13);
+  for (int i = 0; i < 4; ++i) agent.update();  // C = 3: targets copied too
+  expectLayered(agent);
+  agent.saveCheckpoint(path);
+  PdqnAgent other(smallConfig(32));
+  Matrix q_before, accel_before;
+  other.evaluate(states, q_before, accel_before);  // folds its own initial networks first
+  other.importModel(agent.exportModel());
+  expectLayered(other);
+  PdqnAgent resumed(smallConfig(33));
+  resumed.act(states, false);  // folds its own initial networks first
+  resumed.loadCheckpoint(path);
+  expectLayered(resumed);
+  std::remove(path.c_str());
+}

@@ -12,6 +12,7 @@
 #include "palcas_core/action.h"
 #include "palcas_core/model_blob.h"
 #include "palcas_core/nn/adamw.h"
+#include "palcas_core/nn/folded_network.h"
 #include "palcas_core/nn/huber_loss.h"
 #include "palcas_core/nn/network.h"
 #include "palcas_core/pdqn_config.h"
@@ -105,7 +106,7 @@ class PdqnAgent {
 
  private:
   void checkStates(const nn::Matrix& states, const char* who) const;
-  void forwardGreedy(const nn::Matrix& states);  // eval mode; fills act_c_, act_q_
+  void forwardGreedy(const nn::Matrix& states);  // folded eval mode; fills act_c_, act_q_
   void buildQInput(const nn::Matrix& states, const nn::Matrix& c_norm, nn::Matrix& out) const;
   void selectQ(const nn::Matrix& q_out, nn::Index n, nn::Matrix& out) const;
   float updateQ();
@@ -118,6 +119,9 @@ class PdqnAgent {
   PdqnConfig config_;
   std::unique_ptr<Rng> rng_;  // heap: the dropout layers hold its address across moves
   nn::Network mu_, q_, mu_target_, q_target_;
+  // Eval-mode folds of the networks above, re-folded lazily when their state changed
+  // (Network::stateVersion), so act() and the TD target skip batch norm and dropout.
+  nn::FoldedNetwork mu_fold_, q_fold_, mu_target_fold_, q_target_fold_;
   nn::AdamW mu_opt_, q_opt_;
   nn::HuberLoss huber_;
   ReplayBuffer replay_;

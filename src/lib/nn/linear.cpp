@@ -25,10 +25,12 @@ std::string Linear::description() const {
 const Matrix& Linear::forward(const Matrix& input, bool /*training*/) {
   detail::checkBatch(input, in_, "Linear::forward");
   input_ = &input;
-  // y = W x + b, one column per sample.
+  // y = W x + b, one column per sample: start from b and accumulate W x onto it (one pass
+  // less than zero-fill, product, add bias).
+  const Eigen::Map<const Vector> bias(params_.data() + out_ * in_, out_);
   output_.resize(out_, input.cols());
-  output_.noalias() = weight() * input;
-  output_.colwise() += Eigen::Map<const Vector>(params_.data() + out_ * in_, out_);
+  for (Index j = 0; j < input.cols(); ++j) output_.col(j) = bias;
+  output_.noalias() += weight() * input;
   return output_;
 }
 

@@ -1,5 +1,6 @@
 #include "palcas_core/nn/network.h"
 
+#include <atomic>
 #include <stdexcept>
 
 #include "checks.h"
@@ -12,8 +13,21 @@
 
 namespace palcas::nn {
 
+namespace {
+// Process-wide source of state versions, so equal versions mean the same network AND the
+// same state (a copy of a network gets a new version).
+std::atomic<uint64_t> next_state_version{1};
+}  // namespace
+
+void Network::bumpStateVersion() {
+  state_version_ = next_state_version.fetch_add(1, std::memory_order_relaxed);
+}
+
+Network::Network() { bumpStateVersion(); }
+
 Network::Network(const Network& other) : training_(other.training_) {
   for (const auto& layer : other.layers_) layers_.push_back(layer->clone());
+  bumpStateVersion();
 }
 
 Network& Network::operator=(const Network& other) {
@@ -30,6 +44,7 @@ void Network::addLayer(std::unique_ptr<Layer> layer) {
     throw std::invalid_argument("Network::addLayer: " + layer->description() +
                                 " does not fit after " + layers_.back()->description());
   layers_.push_back(std::move(layer));
+  bumpStateVersion();
 }
 
 Index Network::inputSize() const { return layers_.empty() ? 0 : layers_.front()->inputSize(); }
@@ -39,6 +54,7 @@ const Matrix& Network::forward(const Matrix& input) {
   if (layers_.empty()) throw std::logic_error("Network::forward: no layers");
   detail::checkBatch(input, inputSize(), "Network::forward");
   input_ = input;
+  if (training_) bumpStateVersion();  // batch norm updates its running statistics
   const Matrix* x = &input_;
   for (auto& layer : layers_) x = &layer->forward(*x, training_);
   return *x;
@@ -88,6 +104,7 @@ void Network::setParameters(const Vector& values) {
     layer->parameters() = values.segment(offset, layer->parameters().size());
     offset += layer->parameters().size();
   }
+  bumpStateVersion();
 }
 
 Vector Network::getState() const {
@@ -116,6 +133,7 @@ void Network::setState(const Scalar* values, Index count) {
     layer->buffers() = all.segment(offset, layer->buffers().size());
     offset += layer->buffers().size();
   }
+  bumpStateVersion();
 }
 
 std::string Network::layout() const {

@@ -28,6 +28,9 @@ class BatchNorm1d : public Layer {
   Eigen::Map<const Vector> beta() const { return {params_.data() + size_, size_}; }
   Eigen::Map<const Vector> runningMean() const { return {buffers_.data(), size_}; }
   Eigen::Map<const Vector> runningVar() const { return {buffers_.data() + size_, size_}; }
+  Scalar momentum() const { return momentum_; }
+  /// Added to the variance before the square root.
+  Scalar eps() const { return eps_; }
 
  private:
   Index size_;

@@ -16,7 +16,7 @@ namespace palcas::nn {
 /// EVERYTHING FedAvg averages and a saved model holds. Not thread-safe.
 class Network {
  public:
-  Network() = default;
+  Network();
   Network(const Network& other);
   Network& operator=(const Network& other);
   Network(Network&&) = default;
@@ -41,7 +41,12 @@ class Network {
   Index inputSize() const;
   Index outputSize() const;
   size_t layerCount() const { return layers_.size(); }
-  Layer& layer(size_t i) { return *layers_.at(i); }
+  /// Mutable access counts as a state change (see stateVersion()): do not keep the
+  /// reference across a decision.
+  Layer& layer(size_t i) {
+    bumpStateVersion();
+    return *layers_.at(i);
+  }
   const Layer& layer(size_t i) const { return *layers_.at(i); }
 
   Index parameterCount() const;
@@ -64,10 +69,19 @@ class Network {
   /// Random source for the dropout layers (not owned; must outlive the network's use).
   void setRng(Rng* rng);
 
+  /// Identifies this network's parameters and buffers as they are now: a value no other
+  /// network or earlier state of this one had. Changes on addLayer, setParameters,
+  /// setState, a training-mode forward (batch-norm statistics), mutable layer() access
+  /// (how optimisers write) and copying. FoldedNetwork uses it to know when to re-fold.
+  uint64_t stateVersion() const { return state_version_; }
+
  private:
+  void bumpStateVersion();
+
   std::vector<std::unique_ptr<Layer>> layers_;
   bool training_ = true;
   Matrix input_;
+  uint64_t state_version_;
 };
 
 enum class OutputActivation { kNone, kTanh };
