@@ -1,1 +1,6 @@
-# federation_sources (filled by its area)
+# federation sources: the federation server's round logic (ROS-free; palcas_fedserver wraps it)
+list(APPEND PALCAS_CORE_SOURCES
+  lib/federation_server.cpp
+  lib/federation_checkpoint.cpp
+  lib/federation_json.cpp
+)
