@@ -16,6 +16,13 @@ ROWS = [
     ("cavs_seen", "CAVs seen", "{}"),
     ("exiting_cavs", "Exiting CAVs", "{}"),
     ("merging_cavs", "Merging CAVs", "{}"),
+    ("advisories", "Advisories applied", "{}"),
+    ("advisories_rejected", "Advisories rejected", "{}"),
+    ("late_rsu_steps", "Late RSU steps", "{}"),
+    ("decision_ms_p50", "Decision p50 (ms)", "{:.2f}"),
+    ("decision_ms_p90", "Decision p90 (ms)", "{:.2f}"),
+    ("decision_ms_p99", "Decision p99 (ms)", "{:.2f}"),
+    ("federation_rounds", "Federation rounds", "{}"),
     ("sim_seconds", "Simulated (s)", "{:.0f}"),
     ("wall_seconds", "Wall (s)", "{:.1f}"),
     ("real_time_factor", "Real-time factor", "{:.2f}"),
@@ -33,9 +40,11 @@ def fmt(value, pattern):
 
 def main(paths):
     runs = [(pathlib.Path(p).parent.name, json.loads(pathlib.Path(p).read_text())) for p in paths]
+    # Rows no run has (e.g. decision latency of a SUMO-native run) are left out.
+    rows = [r for r in ROWS if any(r[0] in m for _, m in runs)]
     width = max(14, *(len(n) for n, _ in runs))
     print(f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs))
-    for key, label, pattern in ROWS:
+    for key, label, pattern in rows:
         print(f"{label:34s}" + "".join(f"{fmt(m.get(key), pattern):>{width + 2}s}" for _, m in runs))
 
 

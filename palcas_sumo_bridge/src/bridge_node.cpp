@@ -218,6 +218,7 @@ void BridgeNode::applyAdvisories() {
   std::unordered_set<std::string> advised;
   std::vector<std::pair<std::string, int>> advised_actions;
   for (const auto& array : pending_) {
+    if (!array->advisories.empty()) decision_ms_.push_back(array->decision_ms);
     for (const auto& a : array->advisories) {
       const metrics::AdvisoryRequest request = toRequest(a, array->step, array->rsu_id);
       const sim::VehicleRecord* vehicle = session_->find(a.vehicle_id);
@@ -269,11 +270,12 @@ void BridgeNode::publishMetrics() {
   msg.step = session_->stepCount();
   metrics_pub_.publish(msg);
   // Time left over every remaining episode, at this episode's pace.
-  const double remaining_sim_s = options_.scenario.duration_s * (options_.episodes - episode_) - msg.sim_seconds;
+  const int episodes_left = options_.first_episode + options_.episodes - episode_;
+  const double remaining_sim_s = options_.scenario.duration_s * episodes_left - msg.sim_seconds;
   const double left_s = msg.real_time_factor > 0.0 ? remaining_sim_s / msg.real_time_factor : 0.0;
   ROS_INFO("palcas bridge: episode %d/%d  t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
            "DSR %5.1f%%  MSR %5.1f%%  RTF %5.1fx  ~%.0f s left",
-           episode_ + 1, options_.episodes, msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
+           episode_ + 1, options_.first_episode + options_.episodes, msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
            msg.efficiency_cav_mps, msg.collision_rate_pct, msg.dsr_pct, msg.msr_pct,
            msg.real_time_factor, left_s);
 }
@@ -286,6 +288,7 @@ void BridgeNode::startEpisode(int episode) {
   controlled_.clear();
   pending_.clear();
   late_by_rsu_.clear();
+  decision_ms_.clear();
 }
 
 void BridgeNode::runEpisode(int episode) {
@@ -326,15 +329,19 @@ void BridgeNode::runEpisode(int episode) {
     summary.rejections_by_reason[metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(r))] =
         measure_->metrics().rejections(static_cast<metrics::RejectionReason>(r));
   summary.timing = timer;
+  summary.decision_ms = decision_ms_;
   writeMetricsJson(options_, summary, episode);
   ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
-           options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());
+           options_.first_episode + options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());
 }
 
 int BridgeNode::run() {
   waitForPeers();
-  for (int episode = 0; episode < options_.episodes && ros::ok(); ++episode) {
-    if (episode > 0) startEpisode(episode);
+  const int first = options_.first_episode;
+  episode_ = first;
+  if (first > 0) startEpisode(first);  // a resumed training: seed + first, as numbered
+  for (int episode = first; episode < first + options_.episodes && ros::ok(); ++episode) {
+    if (episode > first) startEpisode(episode);
     runEpisode(episode);
   }
   // Stay up a moment: recorders and RSUs still have the last messages in flight.

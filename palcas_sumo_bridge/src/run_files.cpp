@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +16,15 @@ using nlohmann::json;
 namespace fs = std::filesystem;
 
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+/// Nearest-rank percentile of unsorted values; null when there are none.
+json percentile(std::vector<float> values, double p) {
+  if (values.empty()) return json(nullptr);
+  const std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * values.size()));
+  const std::size_t index = rank == 0 ? 0 : rank - 1;
+  std::nth_element(values.begin(), values.begin() + index, values.end());
+  return json(values[index]);
+}
 
 /// FNV-1a 64: a short, stable fingerprint of the configuration snapshot.
 std::string fingerprint(const std::string& text) {
@@ -196,6 +206,10 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"advisories_rejected", m.advisories_rejected},
               {"rejections_by_reason", s.rejections_by_reason},
               {"late_rsu_steps", m.late_rsu_steps},
+              {"decision_ms_p50", percentile(s.decision_ms, 50)},
+              {"decision_ms_p90", percentile(s.decision_ms, 90)},
+              {"decision_ms_p99", percentile(s.decision_ms, 99)},
+              {"decisions", s.decision_ms.size()},
               {"late_steps_by_rsu", s.late_by_rsu},
               {"sim_seconds", m.sim_seconds},
               {"wall_seconds", s.wall_seconds},
@@ -207,7 +221,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"episodes", o.episodes},
               {"step_timing", timing}};
   writeAtomically(o.out_dir + "/metrics.json", out);
-  if (o.episodes == 1) return;
+  if (o.episodes == 1 && o.first_episode == 0) return;  // a single run: metrics.json only
   const std::string dir = o.out_dir + "/episode_" + std::to_string(episode);
   fs::create_directories(dir);
   writeAtomically(dir + "/metrics.json", out);

@@ -82,6 +82,7 @@ class BridgeNode {
   std::unordered_map<std::string, Control> controlled_;
   std::unordered_set<std::string> late_this_step_;
   std::map<std::string, std::uint64_t> late_by_rsu_;
+  std::vector<float> decision_ms_;  ///< this episode's RSU decision latencies [ms]
   std::chrono::steady_clock::time_point wall_start_;
   double next_metrics_s_ = 0.0;
 };

@@ -19,6 +19,7 @@ struct BridgeOptions {
   sim::ScenarioConfig scenario;
   std::string out_dir;             ///< run folder: generated scenario, metrics.json, manifest.json
   int episodes = 1;                ///< episodes in this run; episode k uses SUMO seed + k
+  int first_episode = 0;           ///< number of the first episode (a resumed training continues)
   std::string command_line;        ///< how the run was started, for the manifest
   std::string git_commit;          ///< for the manifest
   // SUMO.

@@ -41,6 +41,8 @@ struct RunSummary {
   std::map<std::string, std::uint64_t> late_by_rsu;
   std::map<std::string, std::uint64_t> rejections_by_reason;
   StepTimer timing;
+  /// RSU decision latencies (AdvisoryArray.decision_ms of answers that advised) [ms].
+  std::vector<float> decision_ms;
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

@@ -1,0 +1,45 @@
+#pragma once
+// The federation server node: a thin ROS shell around palcas::FederationServer. Services
+// take RSU submissions and hand out the global model; a ROS-time timer (sim time under
+// use_sim_time) closes rounds; each closed round is logged, published and checkpointed.
+
+#include <palcas_msgs/FetchGlobalModel.h>
+#include <palcas_msgs/SubmitWeights.h>
+#include <ros/ros.h>
+
+#include <palcas_core/federation_server.h>
+
+#include "palcas_fedserver/fedserver_options.h"
+
+namespace palcas::fedserver {
+
+class FedServerNode {
+ public:
+  /// Loads options, builds the initial global model (or resumes from the checkpoint),
+  /// advertises, offers the services, starts the timer. @throws std::exception naming
+  /// what failed (invalid parameter, unreadable checkpoint, layout mismatch).
+  FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+ private:
+  /// Fresh start: PdqnAgent(learning).exportModel(); resume: the checkpoint, whose
+  /// layout must be the learning config's (otherwise no RSU could submit to it).
+  void initializeModel();
+  bool onSubmit(palcas_msgs::SubmitWeights::Request& req,
+                palcas_msgs::SubmitWeights::Response& res);
+  bool onFetch(palcas_msgs::FetchGlobalModel::Request& req,
+               palcas_msgs::FetchGlobalModel::Response& res);
+  void onTimer(const ros::TimerEvent&);
+  /// poll() at the current ROS time; on a close: log, checkpoint, publish the version.
+  void pollAndReport();
+  void publishStatus();
+  static double nowS() { return ros::Time::now().toSec(); }
+
+  ros::NodeHandle nh_, private_nh_;
+  FedServerOptions options_;
+  FederationServer server_;
+  ros::Publisher status_pub_, version_pub_;
+  ros::ServiceServer submit_srv_, fetch_srv_;
+  ros::Timer poll_timer_;
+};
+
+}  // namespace palcas::fedserver

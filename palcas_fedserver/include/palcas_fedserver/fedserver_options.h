@@ -1,0 +1,29 @@
+#pragma once
+// Every parameter of the federation server node in one struct, loaded in one place
+// (loadFedServerOptions, the only caller of getParam). Meaning, defaults and ranges:
+// README.md of this package and config/fedserver.yaml; ~learning/*: config/learning.yaml.
+
+#include <ros/node_handle.h>
+
+#include <string>
+
+#include <palcas_core/federation_server.h>
+#include <palcas_core/pdqn_config.h>
+
+namespace palcas::fedserver {
+
+struct FedServerOptions {
+  FederationOptions federation;  ///< expected_rsus, quorum, round_deadline, liveness_timeout, max_samples
+  /// ~learning/*: builds the initial global model (PdqnAgent(learning).exportModel()).
+  PdqnConfig learning;
+  std::string checkpoint_dir;            ///< "" = no checkpoints
+  bool resume = false;                   ///< start from checkpoint_dir instead of a fresh model
+  double poll_period_s = 0.5;            ///< ROS-time period of the round-closing timer [s]
+};
+
+/// Reads the node's private parameters. @throws std::invalid_argument naming the key for
+/// a missing required key, a wrong type, a value out of range, or an unknown key under
+/// the node's namespace (a typo is an error, not a silent default).
+FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh);
+
+}  // namespace palcas::fedserver

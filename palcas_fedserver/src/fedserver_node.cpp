@@ -1,0 +1,124 @@
+#include "palcas_fedserver/fedserver_node.h"
+
+#include <std_msgs/String.h>
+#include <std_msgs/UInt32.h>
+
+#include <palcas_core/pdqn_agent.h>
+
+#include <sstream>
+#include <stdexcept>
+
+#include <palcas_rsu/msg_conversion.h>
+#include "palcas_fedserver/topics.h"
+
+namespace palcas::fedserver {
+
+FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh), private_nh_(private_nh), options_(loadFedServerOptions(private_nh_)),
+      server_(options_.federation) {
+  initializeModel();
+  status_pub_ = nh_.advertise<std_msgs::String>(FEDERATION_STATUS_TOPIC, 1, true);
+  version_pub_ = nh_.advertise<std_msgs::UInt32>(GLOBAL_MODEL_VERSION_TOPIC, 1, true);
+  submit_srv_ = nh_.advertiseService(SUBMIT_WEIGHTS_SERVICE, &FedServerNode::onSubmit, this);
+  fetch_srv_ = nh_.advertiseService(FETCH_GLOBAL_MODEL_SERVICE, &FedServerNode::onFetch, this);
+  poll_timer_ = nh_.createTimer(ros::Duration(options_.poll_period_s), &FedServerNode::onTimer, this);
+  std_msgs::UInt32 version;
+  version.data = server_.globalVersion();
+  version_pub_.publish(version);
+  publishStatus();
+  const FederationOptions& f = options_.federation;
+  ROS_INFO("palcas fedserver: round %u, global version %u (%zu values, layout %s), %zu RSU(s) "
+           "expected, quorum %zu, deadline %.1f s, liveness %.1f s, checkpoints %s",
+           server_.round(), server_.globalVersion(), server_.globalModel()->values.size(),
+           server_.globalModel()->layout_id.c_str(), f.expected_rsus.size(), f.effectiveQuorum(),
+           f.round_deadline_s, f.liveness_timeout_s,
+           options_.checkpoint_dir.empty() ? "off" : options_.checkpoint_dir.c_str());
+}
+
+void FedServerNode::initializeModel() {
+  // The agent is built only for its weights and layout: every RSU builds the same agent
+  // from the same learning config and seed, so all start from this model.
+  const PdqnAgent agent(options_.learning);
+  if (!options_.resume) {
+    server_.initialize(agent.exportModel());
+    return;
+  }
+  server_.loadCheckpoint(options_.checkpoint_dir);
+  if (server_.globalModel()->layout_id != agent.layoutId())
+    throw std::runtime_error("checkpoint " + options_.checkpoint_dir + " holds layout '" +
+                             server_.globalModel()->layout_id + "', ~learning/* gives '" +
+                             agent.layoutId() + "'");
+  ROS_INFO("palcas fedserver: resumed from %s", options_.checkpoint_dir.c_str());
+}
+
+bool FedServerNode::onSubmit(palcas_msgs::SubmitWeights::Request& req,
+                             palcas_msgs::SubmitWeights::Response& res) {
+  const palcas_msgs::ModelWeights& w = req.weights;
+  const SubmitResult r = server_.submit(w.rsu_id, w.round, w.model_version, rsu::toModelBlob(w),
+                                        w.sample_count, nowS());
+  if (r.accepted) {
+    ROS_INFO("palcas fedserver: round %u: model from '%s' (n_k %lu)", w.round, w.rsu_id.c_str(),
+             static_cast<unsigned long>(w.sample_count));
+    pollAndReport();  // the last live RSU closes the round at once, not at the next tick
+  } else {
+    ROS_WARN("palcas fedserver: refused a model from '%s': %s", w.rsu_id.c_str(), r.reason.c_str());
+  }
+  res.accepted = r.accepted;
+  res.reason = r.reason;
+  res.round = server_.round();
+  res.global_version = server_.globalVersion();
+  publishStatus();
+  return true;
+}
+
+bool FedServerNode::onFetch(palcas_msgs::FetchGlobalModel::Request& req,
+                            palcas_msgs::FetchGlobalModel::Response& res) {
+  const uint64_t unknown_before = server_.status().fetch_unknown_rsu;
+  const FetchResult r = server_.fetch(req.rsu_id, req.min_version, nowS());
+  res.available = r.available;
+  res.reason = r.reason;
+  // The core keeps the global model finite (validated at start, after every average and
+  // on resume), so what is served here is finite.
+  if (r.available) res.weights = rsu::toMsg(*r.model, SERVER_ID, r.round, r.global_version, 0);
+  if (server_.status().fetch_unknown_rsu != unknown_before) {
+    ROS_WARN("palcas fedserver: %s", r.reason.c_str());
+    publishStatus();
+  }
+  return true;
+}
+
+void FedServerNode::onTimer(const ros::TimerEvent&) { pollAndReport(); }
+
+void FedServerNode::pollAndReport() {
+  if (!server_.poll(nowS())) return;
+  const RoundReport& rr = server_.lastRound();
+  std::ostringstream counts;
+  for (const auto& [id, n] : rr.sample_counts) counts << ' ' << id << '=' << n;
+  if (rr.aggregated)
+    ROS_INFO("palcas fedserver: round %u closed (%s): global version %u, n_k:%s, %.2f s, %lu bytes in",
+             rr.round, rr.on_deadline ? "deadline with quorum" : "every live RSU submitted",
+             rr.global_version, counts.str().c_str(), rr.duration_s,
+             static_cast<unsigned long>(rr.bytes_in));
+  else
+    ROS_ERROR("palcas fedserver: round %u closed but its average is not finite: global version "
+              "%u kept, n_k:%s", rr.round, rr.global_version, counts.str().c_str());
+  if (!options_.checkpoint_dir.empty()) {
+    try {
+      server_.saveCheckpoint(options_.checkpoint_dir);
+    } catch (const std::runtime_error& e) {  // keep federating; the next round retries
+      ROS_ERROR("palcas fedserver: checkpoint failed: %s", e.what());
+    }
+  }
+  std_msgs::UInt32 version;
+  version.data = server_.globalVersion();
+  version_pub_.publish(version);
+  publishStatus();
+}
+
+void FedServerNode::publishStatus() {
+  std_msgs::String msg;
+  msg.data = federationStatusJson(server_.status());
+  status_pub_.publish(msg);
+}
+
+}  // namespace palcas::fedserver

@@ -1,0 +1,38 @@
+#include "palcas_fedserver/fedserver_options.h"
+
+#include <palcas_msgs/param_reader.h>
+#include <palcas_rsu/core_params.h>
+
+#include <limits>
+#include <stdexcept>
+
+namespace palcas::fedserver {
+
+FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh) {
+  palcas_msgs::ParamReader p(private_nh);
+  FedServerOptions o;
+  // The same loader as the RSUs': both build the same network from the same files.
+  o.learning = params::loadPdqnConfig(p);
+  FederationOptions& f = o.federation;
+  f.expected_rsus = p.require<std::vector<std::string>>("expected_rsus");
+  f.quorum = static_cast<size_t>(p.integer("quorum", 0, 0, std::numeric_limits<int>::max()));
+  f.round_deadline_s = p.number("round_deadline", f.round_deadline_s, 1e-3, 1e9);
+  f.liveness_timeout_s =
+      p.number("liveness_timeout", f.liveness_timeout_s, 1e-3, std::numeric_limits<double>::infinity());
+  f.max_samples = p.count("max_samples", f.max_samples, 1);
+  o.checkpoint_dir = p.get<std::string>("checkpoint_dir", o.checkpoint_dir);
+  o.resume = p.get<bool>("resume", o.resume);
+  if (o.resume && o.checkpoint_dir.empty())
+    throw std::invalid_argument("parameter '" + p.fullName("resume") + "' is true but '" +
+                                p.fullName("checkpoint_dir") + "' is empty: nothing to resume from");
+  o.poll_period_s = p.number("poll_period", o.poll_period_s, 1e-3, 3600.0);
+  try {
+    f.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("federation parameters: ") + e.what());
+  }
+  p.rejectUnknownKeys("palcas_fedserver/README.md");
+  return o;
+}
+
+}  // namespace palcas::fedserver

@@ -1,0 +1,98 @@
+// The node's parameter loader on the shipped files (rostest loads them into ~shipped and
+// ~tiny), and its refusals, each naming the key. Broken cases copy ~shipped into their own
+// namespace and change one thing.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include "palcas_fedserver/fedserver_options.h"
+
+using palcas::fedserver::loadFedServerOptions;
+
+namespace {
+
+// A copy of ~shipped under ~<name>, with `change` applied to it.
+ros::NodeHandle caseFrom(const std::string& name, void (*change)(ros::NodeHandle&)) {
+  ros::NodeHandle shipped("~shipped"), nh("~" + name);
+  XmlRpc::XmlRpcValue all;
+  EXPECT_TRUE(shipped.getParam("", all));
+  nh.deleteParam("");
+  nh.setParam("", all);
+  change(nh);
+  return nh;
+}
+
+void expectRefused(const std::string& name, void (*change)(ros::NodeHandle&),
+                   const std::string& needle) {
+  const ros::NodeHandle nh = caseFrom(name, change);
+  try {
+    loadFedServerOptions(nh);
+    ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(FedServerOptions, ShippedFilesLoad) {
+  const auto o = loadFedServerOptions(ros::NodeHandle("~shipped"));
+  EXPECT_EQ(o.federation.expected_rsus, (std::vector<std::string>{"rsu_0", "rsu_1", "rsu_2"}));
+  EXPECT_EQ(o.federation.effectiveQuorum(), 2u);  // quorum 0 -> ceil(2/3 * 3) = 2
+  EXPECT_DOUBLE_EQ(o.federation.round_deadline_s, 30.0);
+  EXPECT_DOUBLE_EQ(o.federation.liveness_timeout_s, 600.0);
+  EXPECT_EQ(o.federation.max_samples, 1000000000u);  // fedserver.yaml
+  EXPECT_EQ(o.learning.hidden_sizes, (std::vector<int>{256, 512, 256}));  // paper
+  EXPECT_EQ(o.learning.state_size, 45);                                    // paper
+  EXPECT_FLOAT_EQ(o.learning.gamma, 0.995f);                               // paper
+  EXPECT_EQ(o.learning.seed, 1u);
+  EXPECT_EQ(o.checkpoint_dir, "");
+  EXPECT_FALSE(o.resume);
+}
+
+TEST(FedServerOptions, TestOverridesLoad) {
+  const auto o = loadFedServerOptions(ros::NodeHandle("~tiny"));
+  EXPECT_EQ(o.learning.hidden_sizes, std::vector<int>{3});
+  EXPECT_EQ(o.learning.state_size, 4);
+  EXPECT_EQ(o.federation.expected_rsus.size(), 3u);
+  EXPECT_EQ(o.federation.effectiveQuorum(), 2u);
+  EXPECT_DOUBLE_EQ(o.federation.round_deadline_s, 1.0);
+}
+
+TEST(FedServerOptions, MaxSamplesIsReadAsAWholeNumber) {
+  const auto nh = caseFrom("max_samples", [](ros::NodeHandle& n) { n.setParam("max_samples", 5000); });
+  EXPECT_EQ(loadFedServerOptions(nh).federation.max_samples, 5000u);
+}
+
+TEST(FedServerOptions, RefusesBadParametersNamingTheKey) {
+  expectRefused("typo", [](ros::NodeHandle& n) { n.setParam("round_dedline", 1.0); },
+                "typo/round_dedline' (see");
+  expectRefused("typo_learning", [](ros::NodeHandle& n) { n.setParam("learning/gama", 0.9); },
+                "learning/gama");
+  expectRefused("learning_range", [](ros::NodeHandle& n) { n.setParam("learning/gamma", 1.5); },
+                "learning/gamma' = 1.5");
+  expectRefused("missing_rsus", [](ros::NodeHandle& n) { n.deleteParam("expected_rsus"); },
+                "expected_rsus' is missing");
+  expectRefused("wrong_type", [](ros::NodeHandle& n) { n.setParam("quorum", "two"); },
+                "quorum' has the wrong type");
+  expectRefused("range", [](ros::NodeHandle& n) { n.setParam("round_deadline", 0.0); },
+                "round_deadline' = 0");
+  expectRefused("quorum", [](ros::NodeHandle& n) { n.setParam("quorum", 4); }, "quorum = 4");
+  expectRefused("no_rsus", [](ros::NodeHandle& n) {
+    n.setParam("expected_rsus", std::vector<std::string>{});
+  }, "expected_rsus is empty");
+  expectRefused("resume", [](ros::NodeHandle& n) { n.setParam("resume", true); },
+                "nothing to resume from");
+  expectRefused("pdqn", [](ros::NodeHandle& n) { n.setParam("learning/batch_size", 1); },
+                "PdqnConfig.batch_size");
+  expectRefused("fractional", [](ros::NodeHandle& n) { n.setParam("max_samples", 10.5); },
+                "not a whole number");
+  expectRefused("fractional_int", [](ros::NodeHandle& n) { n.setParam("quorum", 1.5); },
+                "quorum' = 1.5");
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "fedserver_options_test");
+  ros::NodeHandle keep_alive;
+  return RUN_ALL_TESTS();
+}

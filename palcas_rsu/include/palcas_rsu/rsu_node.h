@@ -1,0 +1,78 @@
+#pragma once
+// The RSU node: a thin ROS shell around palcas_core's RsuController. Per bridge step it
+// answers the lockstep (an AdvisoryArray, empty between decisions); every
+// decision_period_steps it converts the state, calls the controller once for all its CAVs,
+// publishes the advisories, its ClusterState (I2I) and its RsuStatus; in train mode it runs
+// the federation exchange without blocking the advisories.
+
+#include <palcas_msgs/ClusterState.h>
+#include <palcas_msgs/VehicleEventArray.h>
+#include <palcas_msgs/VehicleStateArray.h>
+#include <ros/ros.h>
+
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "palcas_rsu/peer_states.h"
+#include "palcas_rsu/rsu_options.h"
+
+namespace palcas::rsu {
+
+class RsuNode {
+ public:
+  /// Loads options, builds the controller (resuming or loading a policy as configured),
+  /// advertises, subscribes, registers with the bridge, fetches the initial global model.
+  /// @throws std::exception naming what failed.
+  RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+  /// Final checkpoint (train mode with a checkpoint_dir). Call after spinning ends.
+  void shutdown();
+
+ private:
+  void onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg);
+  void onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg);
+  void onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg);
+  void decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
+  void answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
+  void waitForPeers();
+  void registerWithBridge();
+  void loadInitialModel();
+  void federate();
+  bool fetchGlobal(uint32_t min_version);
+  void checkpoint();
+  /// Appends this episode's learning row to <checkpoint_dir>/<rsu_id>/learning.csv.
+  void endEpisodeLog();
+  std::string checkpointDir() const;
+
+  ros::NodeHandle nh_, private_nh_;
+  RsuNodeOptions options_;
+  std::unique_ptr<RsuController> controller_;
+  PeerStates peers_;
+  VehicleOutcomes outcomes_;
+
+  ros::Publisher advisories_pub_, cluster_pub_, status_pub_, submitted_pub_, model_pub_;
+  ros::Subscriber states_sub_, events_sub_, cluster_sub_;
+  ros::ServiceClient submit_client_, fetch_client_;
+
+  std::uint64_t decisions_ = 0;
+  // This episode's learning figures (train mode), for learning.csv.
+  struct EpisodeLog {
+    bool active = false;
+    std::uint64_t last_step = 0;
+    std::uint64_t decisions = 0;
+    std::uint64_t transitions = 0;
+    double reward_sum = 0.0;
+    double decision_ms_sum = 0.0;
+  } episode_log_;
+  /// This zone's density at the previous decision: the "own" global density (veh/km).
+  double last_own_density_ = std::numeric_limits<double>::quiet_NaN();
+  bool first_state_ = true;
+  // Federation round state: the open round as the server last said, whether this RSU
+  // has submitted in it, and whether the server answered the last call.
+  uint32_t server_round_ = 0;
+  bool submitted_ = false;
+  bool federation_reachable_ = false;
+};
+
+}  // namespace palcas::rsu

@@ -1,0 +1,34 @@
+#pragma once
+// Every parameter of the RSU node, loaded in one place (loadRsuNodeOptions, the only caller
+// of the parameter server). Keys: README.md of this package; config/rsu.yaml (~rsu/*,
+// ~state_scales/*), config/reward.yaml (~reward/*), config/learning.yaml (~learning/*).
+
+#include <palcas_core/rsu_controller.h>
+#include <ros/node_handle.h>
+
+#include <string>
+#include <vector>
+
+namespace palcas::rsu {
+
+struct RsuNodeOptions {
+  RsuControllerOptions controller;
+  /// Zone boundaries of the scenario (~zones_m); RSU k manages [zones[k], zones[k+1]).
+  std::vector<double> zones_m;
+  bool whole_road = false;           ///< centralized baseline: one zone over every cluster
+  int decision_period_steps = 1;     ///< bridge steps between decisions
+  std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
+  std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
+  bool resume = false;               ///< continue from the checkpoint in checkpoint_dir
+  int checkpoint_every_decisions = 0;  ///< 0 = only at shutdown
+  bool federation = true;            ///< false: no federation server (baselines)
+  double federation_wait_s = 30.0;   ///< wall time to wait for the server at start [s]
+  bool i2i = true;                   ///< false: no cluster-state exchange (global part unknown)
+  double i2i_stale_after_s = 5.0;    ///< sim time after which a peer's state is stale [s]
+  double register_timeout_s = 60.0;  ///< wall time to wait for the bridge's register service [s]
+};
+
+/// @throws std::invalid_argument naming the key for a bad, unknown or missing parameter.
+RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh);
+
+}  // namespace palcas::rsu

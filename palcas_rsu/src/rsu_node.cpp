@@ -1,0 +1,326 @@
+#include "palcas_rsu/rsu_node.h"
+
+#include <palcas_msgs/AdvisoryArray.h>
+#include <palcas_msgs/FetchGlobalModel.h>
+#include <palcas_msgs/RegisterRsu.h>
+#include <palcas_msgs/RsuStatus.h>
+#include <palcas_msgs/SubmitWeights.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "palcas_rsu/msg_conversion.h"
+#include "palcas_rsu/topics.h"
+
+namespace palcas::rsu {
+namespace fs = std::filesystem;
+
+RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : nh_(nh), private_nh_(private_nh), options_(loadRsuNodeOptions(private_nh_)),
+      controller_(std::make_unique<RsuController>(options_.controller)),
+      peers_(options_.controller.cluster_index, options_.i2i_stale_after_s) {
+  const RsuControllerOptions& c = options_.controller;
+  if (options_.resume) {
+    controller_->loadCheckpoint(checkpointDir());
+    ROS_INFO("%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
+             checkpointDir().c_str(), static_cast<unsigned long>(controller_->agent().gradientSteps()),
+             controller_->modelVersion());
+  }
+  // Federation traffic, latched and once per round: what this RSU sent and what it holds
+  // after loading the global model (for tests, bags and debugging).
+  submitted_pub_ = nh_.advertise<palcas_msgs::ModelWeights>(SUBMITTED_WEIGHTS_TOPIC, 1, true);
+  model_pub_ = nh_.advertise<palcas_msgs::ModelWeights>(MODEL_TOPIC, 1, true);
+  loadInitialModel();
+  advisories_pub_ = nh_.advertise<palcas_msgs::AdvisoryArray>(ADVISORIES_TOPIC, 10);
+  cluster_pub_ = nh_.advertise<palcas_msgs::ClusterState>(CLUSTER_STATES_TOPIC, 10);
+  status_pub_ = nh_.advertise<palcas_msgs::RsuStatus>(RSU_STATUS_TOPIC, 10);
+  states_sub_ = nh_.subscribe(VEHICLE_STATES_TOPIC, 10, &RsuNode::onStates, this,
+                              ros::TransportHints().tcpNoDelay());
+  events_sub_ = nh_.subscribe(VEHICLE_EVENTS_TOPIC, 100, &RsuNode::onEvents, this,
+                              ros::TransportHints().tcpNoDelay());
+  if (options_.i2i)
+    cluster_sub_ = nh_.subscribe(CLUSTER_STATES_TOPIC, 20, &RsuNode::onClusterState, this);
+  waitForPeers();
+  registerWithBridge();
+  ROS_INFO("%s: cluster %d [%.0f, %.0f) m, %s, decides every %d step(s), federation %s, I2I %s",
+           c.rsu_id.c_str(), c.cluster_index, c.x_start_m, c.x_end_m, c.train ? "train" : "eval",
+           options_.decision_period_steps, options_.federation ? "on" : "off", options_.i2i ? "on" : "off");
+}
+
+std::string RsuNode::checkpointDir() const {
+  return (fs::path(options_.checkpoint_dir) / options_.controller.rsu_id).string();
+}
+
+void RsuNode::loadInitialModel() {
+  const RsuControllerOptions& c = options_.controller;
+  if (!c.train && !options_.policy_dir.empty()) {
+    // A federated policy is the server's global model; an independent one is per RSU.
+    const fs::path global = fs::path(options_.policy_dir) / "fedserver" / "global_model.palcas";
+    const fs::path own = fs::path(options_.policy_dir) / c.rsu_id / "model.palcas";
+    const fs::path file = fs::exists(global) ? global : own;
+    if (!fs::exists(file))
+      throw std::runtime_error("policy_dir '" + options_.policy_dir + "' holds neither " +
+                               global.string() + " nor " + own.string());
+    controller_->loadPolicy(file.string());
+    ROS_INFO("%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
+    return;
+  }
+  if (!options_.federation) return;
+  submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
+  fetch_client_ = nh_.serviceClient<palcas_msgs::FetchGlobalModel>(FETCH_MODEL_SERVICE, true);
+  if (!ros::service::waitForService(nh_.resolveName(FETCH_MODEL_SERVICE),
+                                    ros::Duration(options_.federation_wait_s))) {
+    ROS_WARN("%s: federation server not reachable after %.0f s: starting from local weights; "
+             "will join when it answers", c.rsu_id.c_str(), options_.federation_wait_s);
+    return;
+  }
+  // Every RSU starts from the server's model (FedAvg needs a common start); after a resume,
+  // only from a newer one.
+  fetchGlobal(std::max<uint32_t>(1, controller_->modelVersion()));
+}
+
+void RsuNode::waitForPeers() {
+  // I2I messages sent before a peer's connection exists are lost; the bridge starts once
+  // every RSU registered, so connect to every peer first (up to register_timeout).
+  const int zones = static_cast<int>(options_.zones_m.size()) - 1;
+  if (!options_.i2i || options_.whole_road || zones < 2) return;
+  const uint32_t peers = static_cast<uint32_t>(zones - 1);
+  // The RSU also hears itself (an intra-process link on the shared topic): peers + 1.
+  const uint32_t links = peers + 1;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
+  while (ros::ok() && ros::WallTime::now() < deadline &&
+         (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links))
+    ros::WallDuration(0.02).sleep();
+  if (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links)
+    ROS_WARN("%s: I2I: %u of %u peers connected after %.0f s; starting anyway (their states "
+             "count as unknown until they arrive)", options_.controller.rsu_id.c_str(),
+             std::min(cluster_pub_.getNumSubscribers(), cluster_sub_.getNumPublishers()) - 1, peers,
+             options_.register_timeout_s);
+}
+
+void RsuNode::registerWithBridge() {
+  ros::ServiceClient client = nh_.serviceClient<palcas_msgs::RegisterRsu>(REGISTER_RSU_SERVICE);
+  if (!client.waitForExistence(ros::Duration(options_.register_timeout_s))) {
+    ROS_WARN("%s: bridge's %s not available after %.0f s; answering states as they come",
+             options_.controller.rsu_id.c_str(), nh_.resolveName(REGISTER_RSU_SERVICE).c_str(),
+             options_.register_timeout_s);
+    return;
+  }
+  // Registering starts the bridge's step 0: make sure its states reach us first.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
+  while (ros::ok() && states_sub_.getNumPublishers() == 0 && ros::WallTime::now() < deadline)
+    ros::WallDuration(0.02).sleep();
+  palcas_msgs::RegisterRsu srv;
+  srv.request.rsu_id = options_.controller.rsu_id;
+  if (!client.call(srv) || !srv.response.accepted)
+    ROS_WARN("%s: registration refused: %s", options_.controller.rsu_id.c_str(),
+             srv.response.reason.c_str());
+}
+
+void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) { addOutcomes(*msg, outcomes_); }
+
+void RsuNode::onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
+  if (msg->rsu_id == options_.controller.rsu_id) return;
+  try {
+    peers_.update(msg->cluster_index, msg->rsu_id, msg->density_veh_per_km, msg->header.stamp.toSec());
+  } catch (const std::invalid_argument& e) {
+    ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", options_.controller.rsu_id.c_str(), e.what());
+  }
+}
+
+void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
+  const ros::WallTime received = ros::WallTime::now();
+  if (first_state_ && msg->num_lanes != options_.controller.num_lanes) {
+    ROS_FATAL("%s: the road has %u lanes but rsu/num_lanes is %d (the state size depends on it)",
+              options_.controller.rsu_id.c_str(), msg->num_lanes, options_.controller.num_lanes);
+    ros::shutdown();
+    return;
+  }
+  first_state_ = false;
+  if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) decide(*msg, received);
+  else answerEmpty(*msg, received);
+}
+
+void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
+  palcas_msgs::AdvisoryArray out;
+  out.header = msg.header;
+  out.step = msg.step;
+  out.rsu_id = options_.controller.rsu_id;
+  out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
+  advisories_pub_.publish(out);
+}
+
+void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
+  const RsuControllerOptions& c = options_.controller;
+  const double now_s = msg.header.stamp.toSec();
+  palcas_msgs::AdvisoryArray out;
+  out.header = msg.header;
+  out.step = msg.step;
+  out.rsu_id = c.rsu_id;
+  DecisionOutput decision;
+  try {
+    const RoadSnapshot snapshot = toSnapshot(msg);
+    // The own density is not known before deciding; the state builder takes the global
+    // densities as given, so use the peers' view with the last own density.
+    const double unknown = std::numeric_limits<double>::quiet_NaN();
+    const GlobalDensities global = options_.i2i ? peers_.global(last_own_density_, now_s)
+                                                : GlobalDensities{unknown, unknown, unknown};
+    decision = controller_->advise(snapshot, msg.step, now_s, global, outcomes_);
+    outcomes_.clear();
+    last_own_density_ = decision.cluster.density_veh_per_km;
+  } catch (const std::invalid_argument& e) {
+    // A malformed state: answer empty (CAVs keep their commands), say why, keep going.
+    ROS_ERROR_THROTTLE(5.0, "%s: step %lu not decided: %s", c.rsu_id.c_str(),
+                       static_cast<unsigned long>(msg.step), e.what());
+    answerEmpty(msg, received);
+    return;
+  }
+  for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
+  out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
+  advisories_pub_.publish(out);
+  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
+  controller_->learn();  // after publishing: the bridge need not wait for gradient steps
+
+  ++decisions_;
+  if (episode_log_.active && msg.step <= episode_log_.last_step) endEpisodeLog();  // bridge restarted
+  const RsuControllerStats closed = controller_->stats();
+  episode_log_.active = true;
+  episode_log_.last_step = msg.step;
+  episode_log_.decisions++;
+  episode_log_.transitions += closed.transitions_closed;
+  episode_log_.reward_sum += closed.sum_reward;
+  episode_log_.decision_ms_sum += out.decision_ms;
+  if (c.train && options_.federation) federate();
+  if (c.train && options_.checkpoint_every_decisions > 0 && !options_.checkpoint_dir.empty() &&
+      decisions_ % static_cast<std::uint64_t>(options_.checkpoint_every_decisions) == 0)
+    checkpoint();
+
+  const RsuControllerStats s = controller_->stats();
+  palcas_msgs::RsuStatus status;
+  status.header = msg.header;
+  status.step = msg.step;
+  status.rsu_id = c.rsu_id;
+  status.mode = c.train ? "train" : "eval";
+  status.decision_ms = out.decision_ms;
+  status.members = s.member_count;
+  status.action_counts.assign(s.action_counts.begin(), s.action_counts.end());
+  status.mean_reward = s.mean_reward;
+  status.sum_reward = s.sum_reward;
+  status.q_loss = s.q_loss;
+  status.param_loss = s.param_loss;
+  status.epsilon = s.epsilon;
+  status.gradient_steps = s.gradient_steps;
+  status.samples_since_federation = s.samples_since_federation;
+  status.model_version = s.model_version;
+  status.federation_round = s.federation_round;
+  status.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
+  status.federation_reachable = federation_reachable_;
+  status_pub_.publish(status);
+}
+
+bool RsuNode::fetchGlobal(uint32_t min_version) {
+  palcas_msgs::FetchGlobalModel srv;
+  srv.request.rsu_id = options_.controller.rsu_id;
+  srv.request.min_version = min_version;
+  if (!fetch_client_.isValid())
+    fetch_client_ = nh_.serviceClient<palcas_msgs::FetchGlobalModel>(FETCH_MODEL_SERVICE, true);
+  federation_reachable_ = fetch_client_.call(srv);
+  if (!federation_reachable_) {
+    ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; advising with the local model",
+                      options_.controller.rsu_id.c_str());
+    return false;
+  }
+  if (!srv.response.available) return false;
+  server_round_ = srv.response.weights.round;  // the round now open
+  try {
+    controller_->loadGlobalModel(toModelBlob(srv.response.weights), srv.response.weights.model_version);
+    submitted_ = false;
+    model_pub_.publish(toMsg(controller_->exportModel(), options_.controller.rsu_id, server_round_,
+                             controller_->modelVersion(), 0));
+    ROS_INFO("%s: loaded global model version %u (round %u open)", options_.controller.rsu_id.c_str(),
+             srv.response.weights.model_version, server_round_);
+    return true;
+  } catch (const std::invalid_argument& e) {
+    ROS_ERROR("%s: refused the global model: %s; keeping the local one", options_.controller.rsu_id.c_str(),
+              e.what());
+    return false;
+  }
+}
+
+void RsuNode::federate() {
+  // Waiting for the round to close: poll without blocking the advisories.
+  if (submitted_) {
+    fetchGlobal(controller_->modelVersion() + 1);
+    return;
+  }
+  if (!controller_->federationDue()) return;
+  palcas_msgs::SubmitWeights srv;
+  srv.request.weights = toMsg(controller_->exportModel(), options_.controller.rsu_id, server_round_,
+                              controller_->modelVersion(), controller_->samplesSinceFederation());
+  if (!submit_client_.isValid())
+    submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
+  federation_reachable_ = submit_client_.call(srv);
+  if (!federation_reachable_) {
+    ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; will submit again later",
+                      options_.controller.rsu_id.c_str());
+    return;
+  }
+  server_round_ = srv.response.round;
+  if (srv.response.accepted) {
+    submitted_ = true;
+    submitted_pub_.publish(srv.request.weights);
+    ROS_INFO("%s: submitted model for round %u (n_k = %lu)", options_.controller.rsu_id.c_str(),
+             srv.request.weights.round, static_cast<unsigned long>(srv.request.weights.sample_count));
+  } else if (srv.response.global_version > controller_->modelVersion()) {
+    // The round moved on without us (we were late or away): take the newer global model.
+    ROS_WARN("%s: submission refused (%s); fetching global version %u", options_.controller.rsu_id.c_str(),
+             srv.response.reason.c_str(), srv.response.global_version);
+    fetchGlobal(srv.response.global_version);
+  } else {
+    ROS_WARN_THROTTLE(10.0, "%s: submission refused: %s", options_.controller.rsu_id.c_str(),
+                      srv.response.reason.c_str());
+  }
+}
+
+void RsuNode::checkpoint() {
+  try {
+    controller_->saveCheckpoint(checkpointDir());
+    controller_->agent().saveModel((fs::path(checkpointDir()) / "model.palcas").string());
+  } catch (const std::exception& e) {
+    ROS_ERROR("%s: checkpoint failed: %s", options_.controller.rsu_id.c_str(), e.what());
+  }
+}
+
+void RsuNode::endEpisodeLog() {
+  if (!episode_log_.active || options_.checkpoint_dir.empty()) {
+    episode_log_ = EpisodeLog{};
+    return;
+  }
+  fs::create_directories(checkpointDir());
+  const fs::path path = fs::path(checkpointDir()) / "learning.csv";
+  const bool fresh = !fs::exists(path);
+  std::ofstream rows(path, std::ios::app);
+  if (fresh)
+    rows << "rsu_id,mode,decisions,transitions,mean_reward,sum_reward,epsilon,gradient_steps,"
+            "q_loss,param_loss,model_version,federation_round,decision_ms_mean\n";
+  const RsuControllerStats s = controller_->stats();
+  const EpisodeLog& e = episode_log_;
+  rows << options_.controller.rsu_id << ',' << (options_.controller.train ? "train" : "eval") << ','
+       << e.decisions << ',' << e.transitions << ','
+       << (e.transitions ? e.reward_sum / e.transitions : std::nan("")) << ',' << e.reward_sum << ','
+       << s.epsilon << ',' << s.gradient_steps << ',' << s.q_loss << ',' << s.param_loss << ','
+       << s.model_version << ',' << s.federation_round << ','
+       << (e.decisions ? e.decision_ms_sum / e.decisions : 0.0) << '\n';
+  episode_log_ = EpisodeLog{};
+}
+
+void RsuNode::shutdown() {
+  endEpisodeLog();
+  if (options_.controller.train && !options_.checkpoint_dir.empty()) {
+    checkpoint();
+    ROS_INFO("%s: checkpoint written to %s", options_.controller.rsu_id.c_str(), checkpointDir().c_str());
+  }
+}
+
+}  // namespace palcas::rsu

@@ -1,0 +1,68 @@
+#include "palcas_rsu/rsu_options.h"
+
+#include <palcas_msgs/param_reader.h>
+
+#include <limits>
+
+#include "palcas_rsu/core_params.h"
+
+namespace palcas::rsu {
+
+RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh) {
+  palcas_msgs::ParamReader p(private_nh);
+  RsuNodeOptions o;
+  RsuControllerOptions& c = o.controller;
+  c.rsu_id = p.get<std::string>("rsu/rsu_id", c.rsu_id);
+  c.cluster_index = p.integer("rsu/cluster_index", c.cluster_index, 0, 1000);
+  c.x_start_m = p.number("rsu/x_start_m", c.x_start_m, -1e9, 1e9);
+  c.x_end_m = p.number("rsu/x_end_m", c.x_end_m, -1e9, 1e9);
+  // The scenario's zones (config/scenarios/<name>/rsus.yaml) give the bounds when present.
+  o.zones_m = p.get<std::vector<double>>("zones_m", {});
+  o.whole_road = p.get<bool>("whole_road", false);
+  if (!o.zones_m.empty()) {
+    for (std::size_t i = 1; i < o.zones_m.size(); ++i)
+      if (!(o.zones_m[i] > o.zones_m[i - 1]))
+        throw std::invalid_argument("parameter '" + p.fullName("zones_m") + "' must increase");
+    const int zones = static_cast<int>(o.zones_m.size()) - 1;
+    if (o.whole_road) {
+      c.x_start_m = o.zones_m.front();
+      c.x_end_m = o.zones_m.back();
+    } else if (c.cluster_index >= zones) {
+      throw std::invalid_argument("parameter '" + p.fullName("rsu/cluster_index") + "' = " +
+                                  std::to_string(c.cluster_index) + " but '" + p.fullName("zones_m") +
+                                  "' has " + std::to_string(zones) + " zone(s)");
+    } else {
+      c.x_start_m = o.zones_m[c.cluster_index];
+      c.x_end_m = o.zones_m[c.cluster_index + 1];
+    }
+  }
+  c.num_lanes = p.integer("rsu/num_lanes", c.num_lanes, 1, 100);
+  c.train = p.get<bool>("rsu/train", c.train);
+  c.gradient_steps_per_decision =
+      p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
+  c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);
+  c.collision_penalty = p.number("rsu/collision_penalty", c.collision_penalty, 0.0, 1e9);
+  o.decision_period_steps = p.integer("rsu/decision_period_steps", o.decision_period_steps, 1, 100000);
+  c.reward = params::loadRewardParams(p);
+  c.scales = params::loadStateScales(p);
+  c.pdqn = params::loadPdqnConfig(p);
+  o.policy_dir = p.get<std::string>("policy_dir", o.policy_dir);
+  o.checkpoint_dir = p.get<std::string>("checkpoint_dir", o.checkpoint_dir);
+  o.resume = p.get<bool>("resume", o.resume);
+  if (o.resume && o.checkpoint_dir.empty())
+    throw std::invalid_argument("parameter '" + p.fullName("resume") + "' is true but '" +
+                                p.fullName("checkpoint_dir") + "' is empty: nothing to resume from");
+  o.checkpoint_every_decisions =
+      p.integer("checkpoint_every_decisions", o.checkpoint_every_decisions, 0, std::numeric_limits<int>::max());
+  o.federation = p.get<bool>("federation", o.federation);
+  if (!o.federation) c.federation_interval_steps = 0;  // never due
+  o.federation_wait_s = p.number("federation_wait", o.federation_wait_s, 0.0, 3600.0);
+  o.i2i = p.get<bool>("i2i", o.i2i);
+  o.i2i_stale_after_s = p.number("i2i_stale_after", o.i2i_stale_after_s, 1e-3, 1e9);
+  o.register_timeout_s = p.number("register_timeout", o.register_timeout_s, 0.0, 3600.0);
+  p.rejectUnknownKeys("palcas_rsu/README.md");
+  c.validate();
+  return o;
+}
+
+}  // namespace palcas::rsu
