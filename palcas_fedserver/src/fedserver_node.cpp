@@ -5,6 +5,7 @@
 
 #include <palcas_core/pdqn_agent.h>
 
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -39,7 +40,14 @@ void FedServerNode::initializeModel() {
   // The agent is built only for its weights and layout: every RSU builds the same agent
   // from the same learning config and seed, so all start from this model.
   const PdqnAgent agent(options_.learning);
-  if (!options_.resume) {
+  const bool have_checkpoint =
+      std::ifstream(options_.checkpoint_dir + "/" + FederationServer::STATE_FILE).good();
+  if (!options_.resume || !have_checkpoint) {
+    // A training that stopped before the first round closed has nothing to resume: start
+    // from the initial model (the RSUs do the same), and say so.
+    if (options_.resume)
+      ROS_WARN("palcas fedserver: resume requested but %s holds no checkpoint; starting afresh",
+               options_.checkpoint_dir.c_str());
     server_.initialize(agent.exportModel());
     return;
   }

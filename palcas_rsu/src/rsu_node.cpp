@@ -21,7 +21,11 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       controller_(std::make_unique<RsuController>(options_.controller)),
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s) {
   const RsuControllerOptions& c = options_.controller;
-  if (options_.resume) {
+  if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
+    // A training that stopped before this RSU wrote anything: start afresh, say so.
+    ROS_WARN("%s: resume requested but %s holds no checkpoint; starting afresh", c.rsu_id.c_str(),
+             checkpointDir().c_str());
+  } else if (options_.resume) {
     controller_->loadCheckpoint(checkpointDir());
     ROS_INFO("%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
              checkpointDir().c_str(), static_cast<unsigned long>(controller_->agent().gradientSteps()),

@@ -298,6 +298,7 @@ void BridgeNode::runEpisode(int episode) {
   StepTimer timer;
   publishStep();
   while (ros::ok() && session_->timeS() < duration_s - 1e-9) {
+    const auto t_wait = std::chrono::steady_clock::now();
     if (lockstep_->enabled()) waitForAdvisories();
     applyAdvisories();
     const auto t0 = std::chrono::steady_clock::now();
@@ -306,7 +307,8 @@ void BridgeNode::runEpisode(int episode) {
     publishStep();
     const auto t2 = std::chrono::steady_clock::now();
     timer.add(session_->vehicles().size(), std::chrono::duration<double>(t1 - t0).count(),
-              std::chrono::duration<double>(t2 - t1).count());
+              std::chrono::duration<double>(t2 - t1).count(),
+              std::chrono::duration<double>(t0 - t_wait).count());
     if (session_->timeS() >= next_metrics_s_ - 1e-9) {
       publishMetrics();
       next_metrics_s_ += options_.metrics_period_s;

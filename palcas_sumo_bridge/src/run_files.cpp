@@ -98,11 +98,12 @@ json bridgeJson(const BridgeOptions& o) {
 
 }  // namespace
 
-void StepTimer::add(std::size_t vehicles, double sumo_s, double bridge_s) {
+void StepTimer::add(std::size_t vehicles, double sumo_s, double bridge_s, double lockstep_s) {
   Bucket& b = buckets_[vehicles / BUCKET_WIDTH * BUCKET_WIDTH];
   ++b.steps;
   b.sumo_s += sumo_s;
   b.bridge_s += bridge_s;
+  b.lockstep_s += lockstep_s;
 }
 
 std::string prepareScenario(const BridgeOptions& o) {
@@ -186,7 +187,8 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
                       {"vehicles_to", first + StepTimer::BUCKET_WIDTH - 1},
                       {"steps", b.steps},
                       {"sumo_ms_per_step", 1e3 * b.sumo_s / b.steps},
-                      {"bridge_ms_per_step", 1e3 * b.bridge_s / b.steps}});
+                      {"bridge_ms_per_step", 1e3 * b.bridge_s / b.steps},
+                      {"lockstep_ms_per_step", 1e3 * b.lockstep_s / b.steps}});
   json out = {{"efficiency_all_mps", number(m.efficiency_all_mps)},
               {"efficiency_cav_mps", number(m.efficiency_cav_mps)},
               {"collision_rate_pct", number(m.collision_rate_pct)},
@@ -221,11 +223,12 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"episodes", o.episodes},
               {"step_timing", timing}};
   writeAtomically(o.out_dir + "/metrics.json", out);
-  if (o.episodes == 1 && o.first_episode == 0) return;  // a single run: metrics.json only
-  const std::string dir = o.out_dir + "/episode_" + std::to_string(episode);
-  fs::create_directories(dir);
-  writeAtomically(dir + "/metrics.json", out);
-  // One row per episode, for learning curves.
+  if (o.episodes > 1 || o.first_episode > 0) {  // several episodes: each keeps its own file
+    const std::string dir = o.out_dir + "/episode_" + std::to_string(episode);
+    fs::create_directories(dir);
+    writeAtomically(dir + "/metrics.json", out);
+  }
+  // One row per episode (also for a single one), for learning curves.
   const std::string csv = o.out_dir + "/episodes.csv";
   const bool fresh = !fs::exists(csv);
   std::ofstream rows(csv, std::ios::app);

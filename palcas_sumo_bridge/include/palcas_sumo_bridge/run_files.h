@@ -16,15 +16,18 @@
 
 namespace palcas::bridge {
 
-/// Bridge cost per step against the number of vehicles on the road: SUMO's own step and
-/// the bridge's work around it (conversion, publishing, measuring), in buckets of 50 vehicles.
+/// Cost per step against the number of vehicles on the road, in buckets of 50 vehicles:
+/// SUMO's own step (with reading the subscriptions), the bridge's work around it
+/// (conversion, publishing, measuring) and the lockstep (waiting for the RSUs' answers and
+/// applying them).
 class StepTimer {
  public:
-  void add(std::size_t vehicles, double sumo_s, double bridge_s);
+  void add(std::size_t vehicles, double sumo_s, double bridge_s, double lockstep_s);
   struct Bucket {
     std::uint64_t steps = 0;
     double sumo_s = 0.0;
     double bridge_s = 0.0;
+    double lockstep_s = 0.0;
   };
   const std::map<std::size_t, Bucket>& buckets() const { return buckets_; }
   static constexpr std::size_t BUCKET_WIDTH = 50;
@@ -62,9 +65,8 @@ void completeManifest(const BridgeOptions& options, const std::string& sumo_vers
 /// is missing when the file is not a PALCAS manifest.
 MeasureRules readMeasureRules(const std::string& manifest_path);
 
-/// Writes the episode's metrics atomically (NaN as null) to <out_dir>/metrics.json; with
-/// several episodes also to <out_dir>/episode_<k>/metrics.json and a row of
-/// <out_dir>/episodes.csv.
+/// Writes the episode's metrics atomically (NaN as null) to <out_dir>/metrics.json, a row of
+/// <out_dir>/episodes.csv, and with several episodes <out_dir>/episode_<k>/metrics.json.
 void writeMetricsJson(const BridgeOptions& options, const RunSummary& summary, int episode);
 
 }  // namespace palcas::bridge

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -24,12 +26,27 @@ constexpr double INF = std::numeric_limits<double>::infinity();
 // Action codes as palcas::Action / palcas_msgs/Advisory.
 constexpr int LANE_LEFT = 0, LANE_RIGHT = 1, ACCELERATE = 2, KEEP = 3;
 
+// Every variable SUMO builds for every vehicle every step costs time, so the list is short:
+// the lane id carries edge and lane index, and the heading (only for drawing) comes from
+// successive positions.
 const std::vector<int>& vehicleVariables() {
   static const std::vector<int> vars = {
-      libsumo::VAR_POSITION,   libsumo::VAR_SPEED,      libsumo::VAR_ACCELERATION,
-      libsumo::VAR_SPEED_LAT,  libsumo::VAR_ROAD_ID,    libsumo::VAR_LANE_INDEX,
-      libsumo::VAR_LANEPOSITION, libsumo::VAR_LANEPOSITION_LAT, libsumo::VAR_ANGLE};
+      libsumo::VAR_POSITION,  libsumo::VAR_SPEED,        libsumo::VAR_ACCELERATION,
+      libsumo::VAR_SPEED_LAT, libsumo::VAR_LANE_ID,      libsumo::VAR_LANEPOSITION,
+      libsumo::VAR_LANEPOSITION_LAT};
   return vars;
+}
+
+/// "<edge>_<index>" (internal lanes ":<junction>_<n>_<index>") into edge and index.
+void splitLaneId(const std::string& lane_id, std::string* edge, int* index) {
+  const std::size_t cut = lane_id.rfind('_');
+  if (cut == std::string::npos) {
+    *edge = lane_id;
+    *index = -1;
+    return;
+  }
+  *edge = lane_id.substr(0, cut);
+  *index = std::atoi(lane_id.c_str() + cut + 1);
 }
 
 double asDouble(const libsumo::TraCIResults& r, int var) {
@@ -59,6 +76,12 @@ int clusterSuffix(const std::string& s, const std::string& prefix) {
   for (std::size_t i = prefix.size(); i < s.size(); ++i)
     if (!std::isdigit(static_cast<unsigned char>(s[i]))) return -2;
   return std::stoi(s.substr(prefix.size()));
+}
+
+/// PALCAS_TRACE_SUMO=1: every lane-change and route command on stderr (for SUMO bugs).
+bool traceCommands() {
+  static const bool on = std::getenv("PALCAS_TRACE_SUMO") != nullptr;
+  return on;
 }
 
 }  // namespace
@@ -165,6 +188,13 @@ void SumoSession::readNetwork() {
       lane_width_m_ = api::Lane::getWidth(e.id + "_0");
       break;
     }
+  // Mainline edges whose successor has another lane count (into or out of a merge edge):
+  // a SUMO lane index means another lane there.
+  for (const EdgeInfo& e : edges)
+    for (const EdgeInfo& f : edges)
+      if (e.id.compare(0, 5, "main_") == 0 && f.id.compare(0, 5, "main_") == 0 &&
+          std::abs(f.x_start_m - e.x_end_m) < 1.0 && f.lane_count != e.lane_count)
+        index_shift_ahead_.insert(e.id);
 }
 
 int SumoSession::minExpectedVehicles() const { return api::Simulation::getMinExpectedNumber(); }
@@ -247,16 +277,15 @@ void SumoSession::readVehicles() {
     auto pos = r.find(libsumo::VAR_POSITION);
     if (pos != r.end())
       if (auto p = std::dynamic_pointer_cast<libsumo::TraCIPosition>(pos->second)) {
+        const double dx = p->x - v.x_m, dy = p->y - v.map_y_m;
+        if (dx * dx + dy * dy > 1e-6) v.heading_rad = std::atan2(dy, dx);
         v.x_m = p->x;
         v.map_y_m = p->y;
       }
-    // SUMO's angle: degrees clockwise from north (+y); ours: radians counter-clockwise from +x.
-    v.heading_rad = (90.0 - asDouble(r, libsumo::VAR_ANGLE)) * M_PI / 180.0;
     v.speed_mps = asDouble(r, libsumo::VAR_SPEED);
     v.accel_mps2 = asDouble(r, libsumo::VAR_ACCELERATION);
     v.lateral_speed_mps = asDouble(r, libsumo::VAR_SPEED_LAT);
-    v.edge = asString(r, libsumo::VAR_ROAD_ID);
-    v.sumo_lane_index = static_cast<int>(asDouble(r, libsumo::VAR_LANE_INDEX));
+    splitLaneId(asString(r, libsumo::VAR_LANE_ID), &v.edge, &v.sumo_lane_index);
     v.lane_pos_m = asDouble(r, libsumo::VAR_LANEPOSITION);
     v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
     updateDerived(v);
@@ -296,6 +325,10 @@ void SumoSession::manageExit(VehicleRecord& v) {
   // On the edge feeding its off-ramp: commit to the exit while in lane 1, withdraw when it
   // leaves lane 1 (the off-ramp only connects from lane 1).
   const bool in_exit_lane = v.lane == 1;
+  if (traceCommands() && in_exit_lane != v.exit_committed)
+    std::fprintf(stderr, "[sumo t=%.1f] %s %s edge=%s lane=%d pos=%.2f\n", time_s_,
+                 in_exit_lane ? "commit-exit" : "withdraw-exit", v.id.c_str(), v.edge.c_str(),
+                 v.sumo_lane_index, v.lane_pos_m);
   if (in_exit_lane && !v.exit_committed) {
     // An explicit two-edge route: SUMO's router (changeTarget) finds no route to the
     // dead-end ramp edge, but the direct connection from lane 1 exists.
@@ -313,8 +346,31 @@ void SumoSession::requestLaneChange(VehicleRecord& v, double duration_s) {
     v.lane_change_target = 0;
     return;
   }
+  if (index_shift_ahead_.count(v.edge) && v.speed_mps > 0.1) {
+    // Stop trying before the boundary: past it this index means another lane.
+    const EdgeInfo& e = road_->edge(v.edge);
+    const double left_m = (e.x_end_m - e.x_start_m) - v.lane_pos_m - v.length_m - 1.0;
+    duration_s = std::min(duration_s, std::max(step_length_s_, left_m / v.speed_mps));
+  }
+  if (traceCommands())
+    std::fprintf(stderr, "[sumo t=%.1f] changeLane %s edge=%s lane=%d pos=%.2f -> index %d for %.1f s\n", time_s_,
+                 v.id.c_str(), v.edge.c_str(), v.sumo_lane_index, v.lane_pos_m, index, duration_s);
   api::Vehicle::changeLane(v.id, index, duration_s);
   v.lane_change_edge = v.edge;
+}
+
+bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
+  // SUMO 1.15's sublane model asserts (MSVehicle::getBackPositionOnLane) and aborts the
+  // process when a forced lane change runs while the vehicle straddles a junction: its back
+  // still on the edge behind, or its front about to cross into the next edge, whose lane
+  // indices may differ (merge edges). Requests are issued only well inside an edge.
+  if (!road_->hasEdge(v.edge) || v.lane_pos_m < v.length_m + 0.5) return false;
+  if (!index_shift_ahead_.count(v.edge)) return true;
+  // The next edge numbers its lanes differently: the whole manoeuvre must fit before it.
+  const EdgeInfo& e = road_->edge(v.edge);
+  const double left_m = (e.x_end_m - e.x_start_m) - v.lane_pos_m;
+  const double time_s = std::max(0.0, v.lane_change_until_s - time_s_);
+  return left_m >= v.speed_mps * time_s + v.length_m + 1.0;
 }
 
 void SumoSession::continueLaneChange(VehicleRecord& v) {
@@ -322,7 +378,7 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
     v.lane_change_target = 0;  // done, or aborted after lane_change_duration_s
     return;
   }
-  if (v.edge != v.lane_change_edge && road_->hasEdge(v.edge))
+  if (v.edge != v.lane_change_edge && wholeOnEdge(v))
     requestLaneChange(v, v.lane_change_until_s - time_s_);
 }
 
@@ -338,10 +394,10 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
                                   "' has no lane " + std::to_string(target_lane));
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
-    // On a junction's internal lane (a fraction of a metre) the request waits for the next
-    // edge: continueLaneChange issues it there.
+    // On a junction, or with its back still on one, the request waits until the vehicle is
+    // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();
-    if (!on_junction) requestLaneChange(v, options_.lane_change_duration_s);
+    if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
     v.command = HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;
   } else if (action == ACCELERATE) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "palcas_sim/road_layout.h"
@@ -58,7 +59,7 @@ struct VehicleRecord {
   int part_cluster = -1;   ///< cluster of the ramp / merge edge it is on, else -1
   double x_m = 0.0;
   double map_y_m = 0.0;      ///< y in SUMO's map frame (for drawing)
-  double heading_rad = 0.0;  ///< driving direction in the map frame, 0 = +x, counter-clockwise
+  double heading_rad = 0.0;  ///< driving direction in the map frame (from its last move), 0 = +x
   double lateral_m = 0.0;
   double speed_mps = 0.0;
   double accel_mps2 = 0.0;
@@ -141,6 +142,7 @@ class SumoSession {
   void updateDerived(VehicleRecord& v) const;
   void manageExit(VehicleRecord& v);
   void continueLaneChange(VehicleRecord& v);
+  bool wholeOnEdge(const VehicleRecord& v) const;
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
@@ -149,6 +151,7 @@ class SumoSession {
   std::unique_ptr<RoadLayout> road_;
   std::string end_edge_;         ///< last mainline edge: where onward routes go
   std::unordered_map<int, std::string> pre_exit_edge_;  ///< cluster -> mainline edge feeding its off-ramp
+  std::unordered_set<std::string> index_shift_ahead_;   ///< edges whose successor numbers lanes differently
   std::vector<std::vector<std::pair<double, double>>> lane_shapes_;
   double lane_width_m_ = 3.2;
   double step_length_s_ = 0.1;

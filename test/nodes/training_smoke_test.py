@@ -1,0 +1,53 @@
+#!/usr/bin/python3
+"""Test: a short training run of the PALCAS arm on the tiny road finishes and leaves what a
+user resumes and evaluates from: metrics, a row per episode, every RSU's checkpoint and
+learning rows, the federation server's state. The same run (seed 1, short schedule) once
+aborted inside SUMO 1.15 at t = 58 s (a lane change asked for while a CAV's back was still
+on a junction); it is the regression test for that.
+"""
+import csv
+import json
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import rospkg
+import rostest
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class TrainingSmokeTest(unittest.TestCase):
+    def test_short_training_finishes_with_checkpoints(self):
+        out = tempfile.mkdtemp(prefix="palcas_train_smoke_")
+        config = rospkg.RosPack().get_path("palcas_config")
+        port = free_port()
+        env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
+        run = subprocess.run(
+            ["roslaunch", "-p", str(port), "palcas_launch", "palcas.launch", "mode:=train", "scenario:=tiny",
+             "clusters:=2", "seed:=1", "duration:=120", "checkpoint_dir:=" + out + "/checkpoints",
+             "out_dir:=" + out, "learning_params:=%s/training/short_learning.yaml" % config,
+             "rsu_params:=%s/training/short_rsu.yaml" % config],
+            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=400, text=True)
+        self.assertNotIn("Assertion", run.stdout, run.stdout[-3000:])
+        self.assertTrue(os.path.exists(out + "/metrics.json"), run.stdout[-3000:])
+        self.assertEqual(json.load(open(out + "/metrics.json"))["sim_seconds"], 120.0)
+        rows = list(csv.DictReader(open(out + "/episodes.csv")))
+        self.assertEqual(len(rows), 1)
+        for rsu in ("rsu_0", "rsu_1"):
+            for name in ("agent.ckpt", "controller.txt", "model.palcas", "learning.csv"):
+                self.assertTrue(os.path.exists("%s/checkpoints/%s/%s" % (out, rsu, name)), (rsu, name))
+            learning = list(csv.DictReader(open("%s/checkpoints/%s/learning.csv" % (out, rsu))))
+            self.assertGreater(int(learning[-1]["gradient_steps"]), 0, rsu)
+        self.assertTrue(os.path.exists(out + "/checkpoints/fedserver/federation_state.json"))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("palcas_tests", "training_smoke_test", TrainingSmokeTest, sys.argv)
