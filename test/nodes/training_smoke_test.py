@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Test: a short training run of the PALCAS arm on the tiny road finishes and leaves what a
 user resumes and evaluates from: metrics, a row per episode, every RSU's checkpoint and
-learning rows, the federation server's state. The same run (seed 1, short schedule) once
+learning rows. The same run (seed 1, short schedule) once
 aborted inside SUMO 1.15 at t = 58 s (a lane change asked for while a CAV's back was still
 on a junction); it is the regression test for that. SUMO 1.15 still aborts rarely on its
 own (a known sublane bug, handled by ./palcas train by resuming): an abort is retried once
@@ -55,7 +55,7 @@ class TrainingSmokeTest(unittest.TestCase):
                 self.assertTrue(os.path.exists("%s/checkpoints/%s/%s" % (out, rsu, name)), (rsu, name))
             learning = list(csv.DictReader(open("%s/checkpoints/%s/learning.csv" % (out, rsu))))
             self.assertGreater(int(learning[-1]["gradient_steps"]), 0, rsu)
-        self.assertTrue(os.path.exists(out + "/checkpoints/fedserver/federation_state.json"))
+        # The server checkpoints after each closed round; 120 s is shorter than one round.
 
 
 if __name__ == "__main__":
