@@ -1,6 +1,7 @@
 // validateAdvisory as a table: one row per rejection reason and per lane edge, plus advisories
 // that must pass. Bridge step 10 and the paper's bounds [-4.5, 2.6] m/s^2 unless a row says.
 #include "palcas_core/advisory_validator.h"
+#include "msg_constants.h"
 
 #include <gtest/gtest.h>
 
@@ -144,22 +145,7 @@ TEST(AdvisoryValidator, ThrowsOnInconsistentInputs) {
   EXPECT_EQ(verdict.reason, RejectionReason::kUnknownVehicle);
 }
 
-namespace {
-
-/// "uint8 NAME=VALUE" constants of a .msg file.
-std::map<std::string, int> msgConstants(const std::string& file) {
-  std::ifstream in(std::string(PALCAS_MSG_DIR) + "/" + file);
-  EXPECT_TRUE(in.good()) << "cannot read " << PALCAS_MSG_DIR << "/" << file;
-  const std::regex constant(R"(^\s*uint8\s+([A-Z_]+)\s*=\s*(\d+))");
-  std::map<std::string, int> out;
-  std::string line;
-  std::smatch m;
-  while (std::getline(in, line))
-    if (std::regex_search(line, m, constant)) out[m[1]] = std::stoi(m[2]);
-  return out;
-}
-
-}  // namespace
+using palcas::test::msgConstants;
 
 TEST(AdvisoryValidator, ReasonCodesMatchAdvisoryRejectionMsg) {
   const auto msg = msgConstants("AdvisoryRejection.msg");

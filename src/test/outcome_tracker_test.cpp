@@ -1,6 +1,7 @@
 // Scripted episodes for OutcomeTracker (and the VehicleEvent codes it emits). Road used
 // throughout: three clusters whose off-ramps leave the mainline at x = 700, 1500, 2300 m.
 #include "palcas_core/outcome_tracker.h"
+#include "msg_constants.h"
 
 #include <gtest/gtest.h>
 
@@ -377,22 +378,7 @@ TEST(VehicleEvent, CodeConversionsAndNames) {
   EXPECT_FALSE(routeFromRamp(RouteKind::kMainExit));
 }
 
-namespace {
-
-/// "uint8 NAME=VALUE" constants of a .msg file.
-std::map<std::string, int> msgConstants(const std::string& file) {
-  std::ifstream in(std::string(PALCAS_MSG_DIR) + "/" + file);
-  EXPECT_TRUE(in.good()) << "cannot read " << PALCAS_MSG_DIR << "/" << file;
-  const std::regex constant(R"(^\s*uint8\s+([A-Z_]+)\s*=\s*(\d+))");
-  std::map<std::string, int> out;
-  std::string line;
-  std::smatch m;
-  while (std::getline(in, line))
-    if (std::regex_search(line, m, constant)) out[m[1]] = std::stoi(m[2]);
-  return out;
-}
-
-}  // namespace
+using palcas::test::msgConstants;
 
 TEST(VehicleEvent, CodesMatchTheMessages) {
   const auto event = msgConstants("VehicleEvent.msg");
