@@ -50,6 +50,7 @@ void validateSituation(const CavSituation& s, const RewardParams& params) {
     finite(key + "gap", s.lateral[i].gap);
     finite(key + "v_lat_ego", s.lateral[i].v_lat_ego);
     finite(key + "v_lat_other", s.lateral[i].v_lat_other);
+    finite(key + "long_gap", s.lateral[i].long_gap);
   }
   if (s.target_lead) {
     finite("target_lead.distance", s.target_lead->distance);
@@ -101,7 +102,7 @@ CavSituation situationFromSnapshot(const NeighbourFinder& finder, const std::str
     const VehicleSnapshot& o = *n->vehicle;
     const double toward = o.lateral_m >= ego.lateral_m ? 1.0 : -1.0;
     s.lateral.push_back({std::fabs(o.lateral_m - ego.lateral_m) - 0.5 * (ego.width_m + o.width_m),
-                         toward * ego.lateral_speed_mps, toward * o.lateral_speed_mps});
+                         toward * ego.lateral_speed_mps, toward * o.lateral_speed_mps, n->gap_m});
   }
 
   // Target lane = the lane toward the exit: the right lane on the mainline (none from

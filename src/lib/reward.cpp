@@ -34,7 +34,10 @@ void safety(const CavSituation& s, const RewardParams& p, RewardBreakdown& r) {
     r.r_s_long += rssSafetyTerm(s.follow->gap, *r.delta_long_follow);
   }
   for (const auto& m : s.lateral) {
-    const double delta = rssLateralSafeDistance(m.v_lat_ego, m.v_lat_other, rss);
+    if (p.lateral_rss_overlap_only != 0.0 && m.long_gap >= 0.0) continue;  // not side by side
+    const double delta = p.lateral_rss_signed != 0.0
+                             ? rssLateralSafeDistanceSigned(m.v_lat_ego, m.v_lat_other, rss)
+                             : rssLateralSafeDistance(m.v_lat_ego, m.v_lat_other, rss);
     r.delta_lat.push_back(delta);
     r.r_s_lat += rssSafetyTerm(m.gap, delta);
   }
@@ -73,7 +76,7 @@ void priorityLaneChange(const CavSituation& s, const RewardParams& p, RewardBrea
 
   // tau_need = n tau0 / (p + eps); tau_tte = d / (v + eps) (+inf with no exit).
   r.tau_need = r.n * p.tau0 / (r.p + p.epsilon);
-  r.tau_tte = std::isinf(d) ? INF : d / (s.v + p.epsilon);
+  r.tau_tte = std::isinf(d) ? INF : d / std::max(s.v + p.epsilon, p.tte_speed_floor_mps);
   // u = -p near the exit and slow, else -1/(1 + exp(tau_tte - tau_need)) = -sigma(tau_need -
   // tau_tte).
   r.u = (d < p.d_th && s.v < p.v_th) ? -r.p : -stableSigmoid(r.tau_need - r.tau_tte);
@@ -100,6 +103,7 @@ RewardBreakdown computeReward(const CavSituation& s, const RewardParams& p) {
   safety(s, p, r);
   // r_c = (a_th - |a|) / (|a_min| - a_max)   (paper, Comfort Reward; 1.9 with defaults)
   r.r_c = (p.a_th - std::fabs(s.a)) / (std::fabs(p.a_min) - p.a_max);
+  if (p.comfort_penalty_only != 0.0) r.r_c = std::min(r.r_c, 0.0);
   priorityLaneChange(s, p, r);
   // r_d = -exp(-(x - len)^2 / (beta len)) on the acceleration lane, else 0 (paper eq. deadlock).
   if (s.accel_lane) {

@@ -40,7 +40,11 @@ const std::vector<std::pair<std::string, Member>>& table() {
       {"ttc_star", &RewardParams::ttc_star},
       {"sigma_ttc", &RewardParams::sigma_ttc},
       {"exit_scale", &RewardParams::exit_scale},
-      {"beta", &RewardParams::beta}};
+      {"beta", &RewardParams::beta},
+      {"lateral_rss_overlap_only", &RewardParams::lateral_rss_overlap_only},
+      {"lateral_rss_signed", &RewardParams::lateral_rss_signed},
+      {"comfort_penalty_only", &RewardParams::comfort_penalty_only},
+      {"tte_speed_floor_mps", &RewardParams::tte_speed_floor_mps}};
   return rows;
 }
 
@@ -86,6 +90,11 @@ void validateRewardParams(const RewardParams& p) {
   require(p.exit_scale > 0.0, "exit_scale", "must be > 0");
   require(p.beta > 0.0, "beta", "must be > 0");
   require(p.tau0 >= 0.0, "tau0", "must be >= 0");
+  for (const char* flag : {"lateral_rss_overlap_only", "lateral_rss_signed", "comfort_penalty_only"}) {
+    const double v = p.*lookup(flag);
+    require(v == 0.0 || v == 1.0, flag, "must be 0 (paper) or 1");
+  }
+  require(p.tte_speed_floor_mps >= 0.0, "tte_speed_floor_mps", "must be >= 0");
   validateRssParams(p.rss());
 }
 

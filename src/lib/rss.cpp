@@ -48,6 +48,18 @@ double rssLateralSafeDistance(double v_ego, double v_other, const RssParams& p) 
   return p.mu_m + std::max(ego_part - other_part, 0.0);
 }
 
+double rssLateralSafeDistanceSigned(double v_ego, double v_other, const RssParams& p) {
+  // As above with v|v| for the squared response speeds: the braking distance toward the
+  // other counts positive, a velocity away from it negative (Shalev-Shwartz et al.).
+  const double rho = p.rho_s;
+  const double two_b = 2.0 * p.a_b_lat_mps2;
+  const double v_i_rho = v_ego + rho * p.a_lat_max_mps2;
+  const double v_m_rho = v_other + rho * p.a_lat_max_mps2;
+  const double ego_part = 0.5 * (v_ego + v_i_rho) * rho + v_i_rho * std::fabs(v_i_rho) / two_b;
+  const double other_part = 0.5 * (v_other + v_m_rho) * rho - v_m_rho * std::fabs(v_m_rho) / two_b;
+  return p.mu_m + std::max(ego_part - other_part, 0.0);
+}
+
 double rssSafetyTerm(double d, double delta) {
   if (delta <= 0.0) return d >= 0.0 ? 0.0 : -1.0;
   return std::min((d - delta) / delta, 0.0);

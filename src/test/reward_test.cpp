@@ -72,7 +72,8 @@ TEST(Reward, DefaultsEqualThePapersValues) {
   EXPECT_EQ(p.sigma_ttc, 0.1);
   EXPECT_EQ(p.exit_scale, 1000.0);
   EXPECT_EQ(p.beta, 10.0);
-  EXPECT_EQ(palcas::rewardParamNames().size(), 28u);
+  // The paper's 28 constants plus the 4 switches of our departures (0 = the paper).
+  EXPECT_EQ(palcas::rewardParamNames().size(), 32u);
 }
 
 TEST(Reward, EfficiencyCombinesEgoAndCluster) {
@@ -531,4 +532,80 @@ TEST(CavSituation, ExitLaneHasNoTargetLane) {
   EXPECT_FALSE(s.target_lead.has_value());
   EXPECT_FALSE(s.target_follow.has_value());
   EXPECT_EQ(s.lateral.size(), 1u);
+}
+
+// ---- Departures from the printed paper (config/departures.yaml); each off = the paper ----
+
+TEST(RewardDepartures, DefaultsAreThePapersFormulas) {
+  const RewardParams p;
+  EXPECT_EQ(p.lateral_rss_overlap_only, 0.0);
+  EXPECT_EQ(p.lateral_rss_signed, 0.0);
+  EXPECT_EQ(p.comfort_penalty_only, 0.0);
+  EXPECT_EQ(p.tte_speed_floor_mps, 0.0);
+}
+
+TEST(RewardDepartures, LateralRssCanCountOnlyNeighboursAlongside) {
+  CavSituation s = quiet();
+  // Gap 0.07 < delta 0.14 -> -0.5 each; the first is 40 m ahead, the second alongside.
+  s.lateral = {{0.07, 0.0, 0.0, 40.0}, {0.07, 0.0, 0.0, -2.0}};
+  EXPECT_NEAR(computeReward(s, RewardParams()).r_s_lat, -1.0, 1e-12);  // paper: both
+  RewardParams p;
+  p.lateral_rss_overlap_only = 1.0;
+  EXPECT_NEAR(computeReward(s, p).r_s_lat, -0.5, 1e-12);
+}
+
+TEST(RewardDepartures, SignedLateralRssDoesNotPayForMovingAway) {
+  CavSituation s = quiet();
+  // Ego moving away from the neighbour at 3 m/s (frame: + = toward it).
+  s.lateral = {{1.0, -3.0, 0.0}};
+  // Paper: v_i,rho = -2.8: ego part 0.5(-3 - 2.8)0.2 + 2.8^2/2 = -0.58 + 3.92 = 3.34;
+  // other part 0.5(0 + 0.2)0.2 - 0.02 = 0; delta = 0.1 + 3.34 = 3.44 > gap 1 -> penalty.
+  const auto paper = computeReward(s, RewardParams());
+  EXPECT_NEAR(paper.delta_lat[0], 3.44, 1e-9);
+  EXPECT_LT(paper.r_s_lat, 0.0);
+  RewardParams p;
+  p.lateral_rss_signed = 1.0;  // ego part -0.58 - 3.92 < 0 -> delta = mu = 0.1
+  const auto ours = computeReward(s, p);
+  EXPECT_NEAR(ours.delta_lat[0], 0.1, 1e-9);
+  EXPECT_EQ(ours.r_s_lat, 0.0);
+  // Toward the neighbour both agree.
+  s.lateral = {{1.0, 3.0, 0.0}};
+  EXPECT_NEAR(computeReward(s, p).delta_lat[0], computeReward(s, RewardParams()).delta_lat[0], 1e-12);
+}
+
+TEST(RewardDepartures, ComfortPenaltyOnlyGivesNoBonusForStandingStill) {
+  CavSituation s = quiet();
+  s.v = 0.0;
+  s.cluster_mean_speed = 0.0;
+  EXPECT_NEAR(computeReward(s, RewardParams()).r_c, 0.7736842, 1e-6);  // paper: a bonus
+  RewardParams p;
+  p.comfort_penalty_only = 1.0;
+  EXPECT_EQ(computeReward(s, p).r_c, 0.0);
+  s.a = -3.0;  // discomfort is still paid
+  EXPECT_NEAR(computeReward(s, p).r_c, -0.8052632, 1e-6);
+}
+
+TEST(RewardDepartures, SpeedFloorKeepsTheUrgencyOfAStoppedCar) {
+  CavSituation s = quiet();
+  s.lane = 5;
+  s.v = 0.0;
+  s.distance_to_exit = 300.0;  // beyond d_th: the sigmoid branch
+  const auto paper = computeReward(s, RewardParams());
+  EXPECT_GT(paper.tau_tte, 1e8);       // 300 / 1e-6
+  EXPECT_NEAR(paper.u, 0.0, 1e-12);    // stopping removed the urgency
+  RewardParams p;
+  p.tte_speed_floor_mps = 10.0;
+  const auto ours = computeReward(s, p);
+  EXPECT_NEAR(ours.tau_tte, 30.0, 1e-9);  // 300 / 10; tau_need = 4 x 2 = 8
+  EXPECT_NEAR(ours.u, -1.0 / (1.0 + std::exp(30.0 - 8.0 / (1.0 + 1e-6))), 1e-9);
+  EXPECT_LT(ours.r_lc, paper.r_lc);
+}
+
+TEST(RewardDepartures, FlagsMustBeZeroOrOne) {
+  RewardParams p;
+  p.lateral_rss_signed = 0.5;
+  EXPECT_THROW(palcas::validateRewardParams(p), std::invalid_argument);
+  p = RewardParams();
+  p.tte_speed_floor_mps = -1.0;
+  EXPECT_THROW(palcas::validateRewardParams(p), std::invalid_argument);
 }

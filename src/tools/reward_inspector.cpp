@@ -28,7 +28,7 @@ Input keys (SI units, lanes 1..L from the right, 0 = acceleration lane / ramp):
   v, a, lane, num_lanes, length            ego speed, acceleration, lane, L, length
   distance_to_exit                         metres to the off-ramp; null = no exit
   lead, follow                             {"gap": m bumper to bumper, "v": m/s} or null
-  lateral                                  up to 4 {"gap", "v_lat_ego", "v_lat_other"} or null
+  lateral                                  up to 4 {"gap", "v_lat_ego", "v_lat_other"[, "long_gap"]} or null
                                            (lateral speeds positive from ego toward the other)
   target_lead                              {"distance" front-to-front, "v", "length"} or null
   target_follow                            {"distance" front-to-front, "v"} or null
@@ -114,9 +114,11 @@ CavSituation parseSituation(const json& in) {
       const std::string where = "lateral[" + std::to_string(i) + "].";
       if (!lateral[i].is_object())
         throw InputError("'" + where.substr(0, where.size() - 1) + "' must be an object");
-      checkKeys(lateral[i], where, {"gap", "v_lat_ego", "v_lat_other"});
-      s.lateral.push_back({number(lateral[i], where, "gap"), number(lateral[i], where, "v_lat_ego"),
-                           number(lateral[i], where, "v_lat_other")});
+      checkKeys(lateral[i], where, {"gap", "v_lat_ego", "v_lat_other", "long_gap"});
+      CavSituation::Lateral m{number(lateral[i], where, "gap"), number(lateral[i], where, "v_lat_ego"),
+                              number(lateral[i], where, "v_lat_other")};
+      if (lateral[i].contains("long_gap")) m.long_gap = number(lateral[i], where, "long_gap");
+      s.lateral.push_back(m);
     }
   }
   if (const json* o = optionalObject(in, "target_lead", {"distance", "v", "length"}))

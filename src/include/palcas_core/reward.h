@@ -38,6 +38,21 @@ struct RewardParams {
   double sigma_ttc = 0.1;                      ///< temperature of p [s]
   double exit_scale = 1000.0;                  ///< exit-proximity scale in sigma(d / scale) [m]
   double beta = 10.0;                          ///< deadlock penalty width factor
+  // Departures from the printed paper (src/doc/state_and_reward.md, "Departures"); each is
+  // 0 = the paper's formula. Flags are 0 or 1.
+  /// 1: the lateral RSS term counts only side neighbours that overlap the ego along the
+  /// road (longitudinal bumper gap < 0): RSS's lateral rule is about cars side by side.
+  /// 0 (paper): every side-lane leader and follower, at any longitudinal distance.
+  double lateral_rss_overlap_only = 0.0;
+  /// 1: the lateral response distances use v|v| (signed) instead of v^2, so moving away
+  /// from a neighbour does not count as moving toward it. 0 (paper): v^2.
+  double lateral_rss_signed = 0.0;
+  /// 1: r_c = min(0, paper r_c): only discomfort is paid; no bonus for standing still.
+  /// 0 (paper): r_c is positive whenever |a| < a_th, stopped cars included.
+  double comfort_penalty_only = 0.0;
+  /// tau_tte = d / max(v + epsilon, this) [m/s]: a stopped car far from its exit still
+  /// feels the urgency at this speed. 0 (paper): d / (v + epsilon), +inf when stopped.
+  double tte_speed_floor_mps = 0.0;
 
   RssParams rss() const { return {rho, a_max, a_b_min, a_b_max, mu, a_b_lat, a_lat_max}; }
 };
@@ -63,6 +78,9 @@ struct CavSituation {
   /// "positive = from the ego toward this neighbour".
   struct Lateral {
     double gap = 0.0, v_lat_ego = 0.0, v_lat_other = 0.0;
+    /// Longitudinal bumper-to-bumper gap [m] (negative = side by side); used only with
+    /// lateral_rss_overlap_only. JSON key "long_gap", optional (default -1: overlapping).
+    double long_gap = -1.0;
   };
   /// Leader in the lane toward the exit: front-to-front distance [m], speed, length [m].
   struct TargetLead {

@@ -34,6 +34,8 @@ double rssLongitudinalSafeDistance(double v_rear_mps, double v_front_mps, const 
 /// Frame: positive = from the ego toward the other vehicle, so v_lat_ego > 0 closes the
 /// gap and v_lat_other > 0 opens it (RSS's "c1 left of c2" frame with the ego as c1).
 double rssLateralSafeDistance(double v_lat_ego_mps, double v_lat_other_mps, const RssParams& p);
+/// The same with signed squares v|v| (RewardParams::lateral_rss_signed).
+double rssLateralSafeDistanceSigned(double v_lat_ego_mps, double v_lat_other_mps, const RssParams& p);
 
 /// One term of r_s,long / r_s,lat: min((d - delta) / delta, 0), <= 0.
 /// delta = 0 (the pair is safe at any non-negative gap) would divide by zero; then the
