@@ -1,6 +1,10 @@
 #include "palcas_core/pdqn_agent.h"
 
+#include "palcas_core/state_layout.h"
+
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -30,7 +34,27 @@ nn::MlpSpec mlpSpec(const PdqnConfig& c, nn::Index in, nn::Index out, nn::Output
 
 constexpr nn::Index ACCEL_INDEX = static_cast<nn::Index>(Action::kAccelerate);
 
+// theta' <- tau theta + (1 - tau) theta' over the whole state (weights and batch-norm
+// running statistics alike).
+void softUpdate(nn::Network& target, const nn::Network& online, float tau) {
+  nn::Vector t = target.getState();
+  t += tau * (online.getState() - t);
+  target.setState(t);
+}
+
 }  // namespace
+
+void PdqnAgent::maskInvalidNextActions(const nn::Matrix& next_states, nn::Matrix& q) const {
+  // Ego lane feature = lane / L (0 on the acceleration lane); L = state_size - 40.
+  const int lanes = config_.state_size - 40;
+  const nn::Index lane_row = static_cast<nn::Index>(EgoFeature::kLane);
+  constexpr float BLOCKED = -std::numeric_limits<float>::infinity();
+  for (nn::Index j = 0; j < next_states.cols(); ++j) {
+    const int lane = static_cast<int>(std::lround(next_states(lane_row, j) * lanes));
+    if (lane >= lanes) q(static_cast<nn::Index>(Action::kLaneLeft), j) = BLOCKED;
+    if (lane <= 1) q(static_cast<nn::Index>(Action::kLaneRight), j) = BLOCKED;
+  }
+}
 
 PdqnAgent::PdqnAgent(const PdqnConfig& config)
     : config_(validated(config)),
@@ -132,8 +156,16 @@ void PdqnAgent::act(const nn::Matrix& states, bool explore, std::vector<Decision
     out[static_cast<size_t>(j)] = Decision{static_cast<Action>(best), accel};
   }
   ++decision_rounds_;
-  // eps <- max(eps_final, eps * decay), once per exploring decision round.
-  if (explore) epsilon_ = std::max(config_.epsilon_final, epsilon_ * config_.epsilon_decay);
+  if (explore) {
+    if (config_.epsilon_linear_rounds > 0.0) {
+      // Linear over a stated share of the training budget (decision rounds).
+      const double step = (config_.epsilon_start - config_.epsilon_final) / config_.epsilon_linear_rounds;
+      epsilon_ = std::max(config_.epsilon_final, epsilon_ - step);
+    } else {
+      // eps <- max(eps_final, eps * decay), once per exploring decision round (paper).
+      epsilon_ = std::max(config_.epsilon_final, epsilon_ * config_.epsilon_decay);
+    }
+  }
 }
 
 std::vector<Decision> PdqnAgent::act(const nn::Matrix& states, bool explore) {
@@ -171,8 +203,11 @@ UpdateStats PdqnAgent::update() {
   stats.q_loss = updateQ();
   stats.param_loss = updateParam();
   ++gradient_steps_;
-  // Hard target update every C gradient steps (DQN, Mnih et al. 2015).
-  if (gradient_steps_ % static_cast<uint64_t>(config_.target_update_steps) == 0) {
+  if (config_.target_soft_tau > 0.0f) {
+    softUpdate(mu_target_, mu_, config_.target_soft_tau);
+    softUpdate(q_target_, q_, config_.target_soft_tau);
+  } else if (gradient_steps_ % static_cast<uint64_t>(config_.target_update_steps) == 0) {
+    // Hard target update every C gradient steps (DQN, Mnih et al. 2015).
     mu_target_.setState(mu_.getState());
     q_target_.setState(q_.getState());
   }
@@ -180,18 +215,25 @@ UpdateStats PdqnAgent::update() {
   return stats;
 }
 
+void PdqnAgent::nextStateValues(const nn::Matrix& next_states, nn::Matrix& values) {
+  // Targets are in eval mode and change every C steps only (hard copies): their folds are
+  // reused between copies.
+  mu_target_fold_.refresh(mu_target_);
+  q_target_fold_.refresh(q_target_);
+  c_norm_ = mu_target_fold_.forward(next_states);
+  buildQInput(next_states, c_norm_, q_in_);
+  selectQ(q_target_fold_.forward(q_in_), next_states.cols(), q_sel_);
+  if (config_.td_target_valid_actions) maskInvalidNextActions(next_states, q_sel_);
+  values = q_sel_.colwise().maxCoeff();
+}
+
 float PdqnAgent::updateQ() {
   const nn::Index n = config_.batch_size;
   const nn::Index passes = config_.multi_pass ? ACTION_COUNT : 1;
   // y = r + gamma (1 - done) max_a' Q_target(s', mu_target(s'))_a'   (P-DQN TD target)
-  // Targets are in eval mode and change every C steps only: their folds are reused.
-  mu_target_fold_.refresh(mu_target_);
-  q_target_fold_.refresh(q_target_);
-  c_norm_ = mu_target_fold_.forward(batch_.next_states);
-  buildQInput(batch_.next_states, c_norm_, q_in_);
-  selectQ(q_target_fold_.forward(q_in_), n, q_sel_);
+  nextStateValues(batch_.next_states, next_values_);
   target_y_ = batch_.rewards.array() + config_.gamma * (1.0f - batch_.dones.array()) *
-                                           q_sel_.colwise().maxCoeff().array();
+                                           next_values_.array();
   // Prediction Q_phi(s, c)_a with the stored (executed) parameter.
   c_norm_.resize(1, n);
   for (nn::Index j = 0; j < n; ++j) c_norm_(0, j) = normFromAccel(batch_.params(0, j));
@@ -230,7 +272,13 @@ float PdqnAgent::updateParam() {
   // L_theta = -(1/N) sum_n sum_a Q(s_n, mu(s_n))_a (P-DQN), so dL/dQ_a = -1/N.
   const float inv_n = 1.0f / static_cast<float>(n);
   double sum = 0.0;
-  if (passes == 1) {
+  if (config_.param_loss_accelerate_only) {
+    // Only Q_ACCELERATE(s, mu(s)): the head of the action the parameter belongs to.
+    grad_q_.setZero(out.rows(), out.cols());
+    const nn::Index col0 = passes > 1 ? ACCEL_INDEX * n : 0;
+    sum = out.block(ACCEL_INDEX, col0, 1, n).cast<double>().sum();
+    grad_q_.block(ACCEL_INDEX, col0, 1, n).setConstant(-inv_n);
+  } else if (passes == 1) {
     sum = out.cast<double>().sum();
     grad_q_.setConstant(out.rows(), out.cols(), -inv_n);
   } else {

@@ -44,6 +44,12 @@ void PdqnConfig::validate() const {
   require(std::isfinite(accel_min_mps2) && std::isfinite(accel_max_mps2) &&
               accel_min_mps2 < accel_max_mps2,
           "accel_min_mps2", accel_min_mps2, "must be finite and < accel_max_mps2");
+  require(target_soft_tau >= 0 && target_soft_tau <= 1, "target_soft_tau", target_soft_tau,
+          "must be in [0, 1]");
+  require(epsilon_linear_rounds >= 0 && std::isfinite(epsilon_linear_rounds),
+          "epsilon_linear_rounds", epsilon_linear_rounds, "must be finite and >= 0");
+  require(!td_target_valid_actions || state_size > 40, "state_size", state_size,
+          "must be 40 + L (L >= 1) with td_target_valid_actions");
   require(accel_noise_std_mps2 >= 0 && std::isfinite(accel_noise_std_mps2),
           "accel_noise_std_mps2", accel_noise_std_mps2, "must be >= 0");
 }

@@ -355,3 +355,116 @@ TEST(PdqnAgent, DecisionsFollowUpdatesImportsAndCheckpoints) {
   expectLayered(resumed);
   std::remove(path.c_str());
 }
+
+// ---- Departures from the printed paper (config/departures.yaml); defaults = the paper ----
+
+TEST(PdqnDepartures, DefaultsAreThePapersBehaviour) {
+  const PdqnConfig c;
+  EXPECT_FALSE(c.td_target_valid_actions);
+  EXPECT_EQ(c.target_soft_tau, 0.0f);
+  EXPECT_FALSE(c.param_loss_accelerate_only);
+  EXPECT_EQ(c.epsilon_linear_rounds, 0.0);
+}
+
+TEST(PdqnDepartures, TdTargetMaxSkipsActionsImpossibleInTheNextState) {
+  // A 3-lane road: state size 43, ego lane feature = lane / 3 at index 4.
+  PdqnConfig c = smallConfig();
+  c.state_size = 43;
+  Rng data(5);
+  Matrix next = randomStates(43, 60, data);
+  for (Index j = 0; j < 60; ++j) next(4, j) = static_cast<float>(j % 3 + 1) / 3.0f;  // lanes 1..3
+  // Teach both agents that LEFT pays (+1, terminal), so LEFT has the largest Q almost
+  // everywhere; 51 steps = 17 hard copies (C = 3): the targets then equal the online nets.
+  auto trained = [&](bool valid_only) {
+    PdqnConfig cc = c;
+    cc.td_target_valid_actions = valid_only;
+    PdqnAgent agent(cc);
+    Rng fill(6);
+    for (int i = 0; i < 64; ++i) {
+      const Matrix st = randomStates(43, 1, fill);
+      agent.remember(st.col(0), Decision{Action::kLaneLeft, 0.0f}, 1.0f, st.col(0), true);
+    }
+    for (int i = 0; i < 51; ++i) agent.update();
+    return agent;
+  };
+  PdqnAgent paper = trained(false);
+  PdqnAgent ours = trained(true);
+  Matrix q, accel, v_paper, v_ours;
+  ours.evaluate(next, q, accel);
+  paper.nextStateValues(next, v_paper);
+  ours.nextStateValues(next, v_ours);
+  int differ = 0;
+  for (Index j = 0; j < 60; ++j) {
+    const int lane = static_cast<int>(j % 3 + 1);
+    float best = -1e30f;
+    for (Index a = 0; a < 4; ++a) {
+      if (a == 0 && lane == 3) continue;  // no LEFT from the leftmost lane
+      if (a == 1 && lane == 1) continue;  // no RIGHT from lane 1
+      best = std::max(best, q(a, j));
+    }
+    EXPECT_NEAR(v_ours(0, j), best, 1e-5f) << j;
+    Matrix q_paper;
+    paper.evaluate(next.col(j), q_paper, accel);
+    EXPECT_NEAR(v_paper(0, j), q_paper.col(0).maxCoeff(), 1e-5f) << j;
+    differ += std::abs(v_ours(0, j) - v_paper(0, j)) > 1e-6f;
+  }
+  EXPECT_GT(differ, 0) << "no column where an impossible action had the largest Q: test is vacuous";
+}
+
+TEST(PdqnDepartures, SoftTargetUpdateMovesTargetsByTau) {
+  PdqnConfig c = smallConfig();
+  c.target_soft_tau = 0.25f;
+  PdqnAgent agent(c);
+  fillReplay(agent, 64, 7);
+  const Vector q_target0 = agent.qTargetNetwork().getState();
+  const Vector mu_target0 = agent.paramTargetNetwork().getState();
+  agent.update();
+  const Vector q_expected = q_target0 + 0.25f * (agent.qNetwork().getState() - q_target0);
+  const Vector mu_expected = mu_target0 + 0.25f * (agent.paramNetwork().getState() - mu_target0);
+  EXPECT_TRUE(agent.qTargetNetwork().getState().isApprox(q_expected, 1e-6f));
+  EXPECT_TRUE(agent.paramTargetNetwork().getState().isApprox(mu_expected, 1e-6f));
+  EXPECT_NE(agent.qTargetNetwork().getState(), agent.qNetwork().getState());  // no hard copy
+}
+
+TEST(PdqnDepartures, ParamLossCanUseTheAccelerateHeadOnly) {
+  // One state repeated: every batch is that state whatever the sampling. Without batch norm
+  // and dropout mu(s) is the same in train and eval mode, so the loss is computable here.
+  for (bool accel_only : {false, true}) {
+    PdqnConfig c = smallConfig();
+    c.batch_norm = false;
+    c.dropout = 0.0f;
+    c.param_loss_accelerate_only = accel_only;
+    PdqnAgent agent(c);
+    Rng data(11);
+    const Matrix s = randomStates(5, 1, data);
+    for (int i = 0; i < 32; ++i) agent.remember(s.col(0), Decision{Action::kKeep, 0.0f}, 0.0f, s.col(0), false);
+    Matrix q, accel;
+    agent.evaluate(s, q, accel);
+    const float c_norm = (accel(0, 0) + 0.95f) / 3.55f;  // mu(s) before the update
+    const UpdateStats u = agent.update();
+    nn::Network qnet = agent.qNetwork();  // Q after its step = the Q the mu loss saw
+    qnet.eval();
+    Matrix in(6, 1);
+    in << s, Matrix::Constant(1, 1, c_norm);
+    const Matrix q_after = qnet.forward(in);
+    const float expected = accel_only ? -q_after(2, 0) : -q_after.sum();
+    EXPECT_NEAR(u.param_loss, expected, 1e-4f) << accel_only;
+  }
+}
+
+TEST(PdqnDepartures, LinearEpsilonReachesItsFloorAfterTheStatedRounds) {
+  PdqnConfig c = smallConfig();
+  c.epsilon_start = 1.0;
+  c.epsilon_final = 0.2;
+  c.epsilon_linear_rounds = 4;
+  PdqnAgent agent(c);
+  Rng data(2);
+  const Matrix s = randomStates(5, 3, data);
+  const double expected[] = {0.8, 0.6, 0.4, 0.2, 0.2};
+  for (double e : expected) {
+    agent.act(s, true);
+    EXPECT_NEAR(agent.epsilon(), e, 1e-12);
+  }
+  agent.act(s, false);  // greedy rounds do not count
+  EXPECT_NEAR(agent.epsilon(), 0.2, 1e-12);
+}

@@ -58,6 +58,11 @@ inline PdqnConfig loadPdqnConfig(palcas_msgs::ParamReader& p, const std::string&
   c.accel_noise_std_mps2 =
       static_cast<float>(p.number(k + "accel_noise_std_mps2", c.accel_noise_std_mps2, 0.0, 100.0));
   c.multi_pass = p.get<bool>(k + "multi_pass", c.multi_pass);
+  c.td_target_valid_actions = p.get<bool>(k + "td_target_valid_actions", c.td_target_valid_actions);
+  c.target_soft_tau = static_cast<float>(p.number(k + "target_soft_tau", c.target_soft_tau, 0.0, 1.0));
+  c.param_loss_accelerate_only =
+      p.get<bool>(k + "param_loss_accelerate_only", c.param_loss_accelerate_only);
+  c.epsilon_linear_rounds = p.number(k + "epsilon_linear_rounds", c.epsilon_linear_rounds, 0.0, 1e15);
   c.seed = static_cast<std::uint64_t>(p.integer(k + "seed", static_cast<int>(c.seed), 0, BIG));
   try {
     c.validate();

@@ -69,6 +69,10 @@ class PdqnAgent {
   /// holds fewer than batch_size transitions.
   UpdateStats update();
 
+  /// max_a' Q_target(s', mu_target(s'))_a' per column (1 x n): the bootstrap of the TD
+  /// target; with td_target_valid_actions only over the actions act() may take in s'.
+  void nextStateValues(const nn::Matrix& next_states, nn::Matrix& values);
+
   /// Greedy evaluation without exploration or side effects on epsilon: Q values (4 x n)
   /// and accelerations (1 x n, m/s^2). Same preconditions as act().
   void evaluate(const nn::Matrix& states, nn::Matrix& q_values, nn::Matrix& accel_mps2);
@@ -109,6 +113,8 @@ class PdqnAgent {
   void forwardGreedy(const nn::Matrix& states);  // folded eval mode; fills act_c_, act_q_
   void buildQInput(const nn::Matrix& states, const nn::Matrix& c_norm, nn::Matrix& out) const;
   void selectQ(const nn::Matrix& q_out, nn::Index n, nn::Matrix& out) const;
+  // td_target_valid_actions: -inf for the actions act() may not take in each next state.
+  void maskInvalidNextActions(const nn::Matrix& next_states, nn::Matrix& q) const;
   float updateQ();
   float updateParam();
   float accelFromNorm(float c) const { return accel_mid_ + accel_half_ * c; }
@@ -131,7 +137,7 @@ class PdqnAgent {
   // Scratch matrices reused between calls (no allocation at a steady batch size).
   ReplayBatch batch_;
   nn::Matrix c_norm_, q_in_, q_sel_, pred_, target_y_, grad_q_, grad_c_;
-  nn::Matrix act_c_, act_q_in_, act_q_;
+  nn::Matrix act_c_, act_q_in_, act_q_, next_values_;
 };
 
 }  // namespace palcas

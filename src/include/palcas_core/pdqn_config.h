@@ -35,6 +35,25 @@ struct PdqnConfig {
   bool multi_pass = false;
   uint64_t seed = 1;
 
+  // Departures from the printed paper (src/doc/learning.md, "Departures"); the defaults
+  // here are the paper's behaviour.
+  /// true: the TD target's max runs over the actions the policy may take in s' (no LEFT
+  /// from lane L, no RIGHT from lane 1 or the acceleration lane, read from the ego-lane
+  /// feature; needs state_size = 40 + L). false (paper P-DQN): over all four actions,
+  /// including ones act() masks to KEEP and that therefore never get trained.
+  bool td_target_valid_actions = false;
+  /// > 0: Polyak target update theta' <- tau theta + (1 - tau) theta' after every gradient
+  /// step (a horizon of ~1/tau steps, whatever the budget). 0 (paper): hard copy every
+  /// target_update_steps.
+  float target_soft_tau = 0.0f;
+  /// true: the parameter network maximises Q(s, mu(s)) of ACCELERATE only, the one action
+  /// the parameter belongs to. false (P-DQN as printed): the sum over all four heads.
+  bool param_loss_accelerate_only = false;
+  /// > 0: epsilon falls linearly from epsilon_start to epsilon_final over this many
+  /// exploring decision rounds (./palcas train sets it to a fraction of the training
+  /// budget). 0 (paper): geometric decay by epsilon_decay per round.
+  double epsilon_linear_rounds = 0.0;
+
   /// Throws std::invalid_argument naming the first invalid field and its value.
   void validate() const;
 };
