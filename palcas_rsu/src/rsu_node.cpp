@@ -142,8 +142,23 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     return;
   }
   first_state_ = false;
-  if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) decide(*msg, received);
-  else answerEmpty(*msg, received);
+  if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) {
+    decide(*msg, received);
+    return;
+  }
+  answerEmpty(*msg, received);
+  if (options_.controller.train && options_.controller.reward_over_period) {
+    try {
+      controller_->observeStep(toSnapshot(*msg));  // never touches the agent: no join
+    } catch (const std::invalid_argument& e) {
+      ROS_ERROR_THROTTLE(5.0, "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
+                         static_cast<unsigned long>(msg->step), e.what());
+    }
+  }
+}
+
+void RsuNode::joinLearner() {
+  if (learner_.valid()) learner_.get();  // rethrows what learn() threw
 }
 
 void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
@@ -163,6 +178,7 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   out.step = msg.step;
   out.rsu_id = c.rsu_id;
   DecisionOutput decision;
+  joinLearner();
   try {
     const RoadSnapshot snapshot = toSnapshot(msg);
     // The own density is not known before deciding; the state builder takes the global
@@ -184,7 +200,8 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
   advisories_pub_.publish(out);
   if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
-  controller_->learn();  // after publishing: the bridge need not wait for gradient steps
+  if (!options_.learner_thread)
+    controller_->learn();  // after publishing: the bridge need not wait for gradient steps
 
   ++decisions_;
   if (episode_log_.active && msg.step <= episode_log_.last_step) endEpisodeLog();  // bridge restarted
@@ -221,6 +238,9 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   status.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
   status.federation_reachable = federation_reachable_;
   status_pub_.publish(status);
+  // Last: federation and checkpoints above saw the model as the decision used it.
+  if (options_.learner_thread && c.train)
+    learner_ = std::async(std::launch::async, [this] { controller_->learn(); });
 }
 
 bool RsuNode::fetchGlobal(uint32_t min_version) {
@@ -320,6 +340,7 @@ void RsuNode::endEpisodeLog() {
 }
 
 void RsuNode::shutdown() {
+  joinLearner();
   endEpisodeLog();
   if (options_.controller.train && !options_.checkpoint_dir.empty()) {
     checkpoint();

@@ -49,6 +49,12 @@ void RsuControllerOptions::validate() const {
           "gradient_steps_per_decision", gradient_steps_per_decision, "must be finite and >= 0");
   require(std::isfinite(collision_penalty) && collision_penalty >= 0.0, "collision_penalty",
           collision_penalty, "must be finite and >= 0 (it is subtracted)");
+  require(std::isfinite(exit_taken_bonus) && exit_taken_bonus >= 0.0, "exit_taken_bonus",
+          exit_taken_bonus, "must be finite and >= 0 (it is added)");
+  require(std::isfinite(exit_missed_penalty) && exit_missed_penalty >= 0.0, "exit_missed_penalty",
+          exit_missed_penalty, "must be finite and >= 0 (it is subtracted)");
+  require(std::isfinite(merge_failed_penalty) && merge_failed_penalty >= 0.0,
+          "merge_failed_penalty", merge_failed_penalty, "must be finite and >= 0 (it is subtracted)");
   nested("reward", [&] { validateRewardParams(reward); });
   nested("scales", [&] { validateScales(scales); });
   nested("pdqn", [&] { pdqn.validate(); });
@@ -65,7 +71,8 @@ void VehicleOutcomes::add(metrics::VehicleEventKind kind, const std::string& id)
     case K::kArrived: arrived.push_back(id); break;
     case K::kExitOk: exited.push_back(id); break;
     case K::kExitMissed: exit_missed.push_back(id); break;
-    default: break;  // departed / merge events end nothing
+    case K::kMergeFailed: merge_failed.push_back(id); break;
+    default: break;  // departed / merge-ok events end nothing
   }
 }
 
@@ -75,6 +82,7 @@ void VehicleOutcomes::clear() {
   arrived.clear();
   exited.clear();
   exit_missed.clear();
+  merge_failed.clear();
 }
 
 /// One transition to store: (pending s, a) -> (reward, s', done).
@@ -92,6 +100,8 @@ struct RsuController::Observation {
   nn::Matrix member_states;            // state_size x members
   std::vector<double> member_rewards;  // train mode only
   std::vector<Closure> closures;       // train mode only, ordered by id
+  std::vector<std::string> vanished;   // pending CAVs gone without an event (to limbo)
+  std::vector<double> member_exit_m;   // distance to exit of each member (train mode)
 };
 
 namespace {
@@ -169,6 +179,7 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
     if (isMember(v) && removed.count(v.id) == 0) {
       obs.member_ids.push_back(v.id);
       obs.member_lanes.push_back(v.lane);
+      obs.member_exit_m.push_back(v.distance_to_exit_m);
     }
   }
   if (!obs.member_ids.empty())
@@ -179,37 +190,77 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   std::unordered_map<std::string, int> member_column;
   for (size_t i = 0; i < obs.member_ids.size(); ++i)
     member_column.emplace(obs.member_ids[i], static_cast<int>(i));
+  const std::set<std::string> exited(outcomes.exited.begin(), outcomes.exited.end());
+  const std::set<std::string> missed(outcomes.exit_missed.begin(), outcomes.exit_missed.end());
+  const std::set<std::string> merge_failed(outcomes.merge_failed.begin(), outcomes.merge_failed.end());
+  const bool over_period = options_.reward_over_period;
+
+  // Terminal outcomes read from the road itself, so a transition does not depend on
+  // whether the event of the same step arrived before the states (separate topics).
+  auto passedExit = [&](const Pending& p, const VehicleSnapshot& v) {
+    return missed.count(v.id) > 0 ||
+           (std::isfinite(p.distance_to_exit_m) && std::isinf(v.distance_to_exit_m) && v.lane >= 1);
+  };
+  auto onOffRamp = [](const VehicleSnapshot& v) { return v.lane == 0 && !v.on_accel_lane; };
+  auto applyOutcomePenalties = [&](Closure& c, const Pending& p, const VehicleSnapshot& v) {
+    if (merge_failed.count(c.id) > 0) c.reward -= options_.merge_failed_penalty;
+    if (passedExit(p, v)) {
+      c.reward -= options_.exit_missed_penalty;
+      if (options_.exit_missed_terminal) c.done = true;
+    }
+  };
+  // Closes a pending CAV that left the road: collision / teleport pay, an exit earns.
+  auto closeRemoved = [&](const std::string& id, const Pending& p) {
+    Closure c{id, p.state, p.lastReward(), true};
+    if (penalised.count(id) > 0) c.reward -= options_.collision_penalty;
+    if (exited.count(id) > 0) c.reward += options_.exit_taken_bonus;
+    if (merge_failed.count(id) > 0) c.reward -= options_.merge_failed_penalty;
+    return c;
+  };
+
+  // Last decision's vanished CAVs: their events have arrived by now.
+  for (const auto& [id, p] : limbo_) obs.closures.push_back(closeRemoved(id, p));
+
   std::vector<std::string> elsewhere;  // pending CAVs on the road but not members now
   for (const auto& [id, pending] : pending_) {
-    Closure c{id, pending.state, pending.reward, true};
     const auto member = member_column.find(id);
+    const auto road = on_road.find(id);
     if (removed.count(id) > 0) {
-      // Gone by an event: s' = s; a collision or teleport also pays the penalty.
-      if (penalised.count(id) > 0) c.reward -= options_.collision_penalty;
+      obs.closures.push_back(closeRemoved(id, pending));
     } else if (member != member_column.end()) {
-      c.next_state = obs.member_states.col(member->second);
-      c.reward = obs.member_rewards[static_cast<size_t>(member->second)];
-      c.done = false;
-    } else if (on_road.count(id) > 0) {
+      const size_t col = static_cast<size_t>(member->second);
+      Closure c{id, obs.member_states.col(member->second),
+                pending.periodReward(obs.member_rewards[col], over_period), false};
+      applyOutcomePenalties(c, pending, *road->second);
+      obs.closures.push_back(std::move(c));
+    } else if (road != on_road.end() && onOffRamp(*road->second)) {
+      // On an off-ramp: a controlled CAV only ever leaves by its own (the bridge commits
+      // the exit from lane 1), so this is the exit taken.
+      Closure c{id, pending.state, pending.lastReward() + options_.exit_taken_bonus, true};
+      obs.closures.push_back(std::move(c));
+    } else if (road != on_road.end()) {
       elsewhere.push_back(id);  // filled below in one batch
-      continue;
-    }  // else: vanished without an event -> done with its last reward, s' = s
-    obs.closures.push_back(std::move(c));
+    } else {
+      obs.vanished.push_back(id);  // no event yet: closed at the next decision
+    }
   }
-  if (elsewhere.empty()) return obs;
-
-  // Handed over (eligible, outside the zone): the value continues under the next RSU,
-  // which shares the federated model -> done = false. Otherwise (e.g. on its off-ramp):
-  // done = true with its current reward. Reward and s' use this cluster's statistics.
-  const nn::Matrix states = builder_.buildStates(finder, elsewhere, stats, global);
-  const std::vector<double> rewards = rewardsOf(finder, elsewhere, stats, options_.reward);
-  for (size_t i = 0; i < elsewhere.size(); ++i) {
-    const VehicleSnapshot& v = *on_road.at(elsewhere[i]);
-    const bool handed_over = v.is_cav && (v.lane >= 1 || v.on_accel_lane);
-    obs.closures.push_back(
-        Closure{elsewhere[i], states.col(static_cast<nn::Index>(i)), rewards[i], !handed_over});
+  if (!elsewhere.empty()) {
+    // Handed over (eligible, outside the zone): the value continues under the next RSU,
+    // which shares the federated model -> done = false. Reward and s' use this cluster's
+    // statistics.
+    const nn::Matrix states = builder_.buildStates(finder, elsewhere, stats, global);
+    const std::vector<double> rewards = rewardsOf(finder, elsewhere, stats, options_.reward);
+    for (size_t i = 0; i < elsewhere.size(); ++i) {
+      const VehicleSnapshot& v = *on_road.at(elsewhere[i]);
+      const Pending& p = pending_.at(elsewhere[i]);
+      const bool handed_over = v.is_cav && (v.lane >= 1 || v.on_accel_lane);
+      Closure c{elsewhere[i], states.col(static_cast<nn::Index>(i)),
+                p.periodReward(rewards[i], over_period), !handed_over};
+      applyOutcomePenalties(c, p, v);
+      obs.closures.push_back(std::move(c));
+    }
   }
-  // Keep the id order of pending_ so the replay order does not depend on the case mix.
+  // Keep the id order so the replay order does not depend on the case mix.
   std::sort(obs.closures.begin(), obs.closures.end(),
             [](const Closure& a, const Closure& b) { return a.id < b.id; });
   return obs;
@@ -250,6 +301,7 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   if (have_last_step_ && step <= last_step_) {  // the bridge restarted: a new episode
     endEpisode();
     obs.closures.clear();
+    obs.vanished.clear();
   }
   have_last_step_ = true;
   last_step_ = step;
@@ -274,11 +326,16 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   }
   if (options_.train) {
     closePending(obs);
+    limbo_.clear();
+    for (const std::string& id : obs.vanished) limbo_[id] = pending_.at(id);
     pending_.clear();
     for (size_t i = 0; i < decisions.size(); ++i) {
-      pending_[obs.member_ids[i]] =
-          Pending{obs.member_states.col(static_cast<nn::Index>(i)), decisions[i],
-                  obs.member_rewards[i]};
+      Pending p;
+      p.state = obs.member_states.col(static_cast<nn::Index>(i));
+      p.decision = decisions[i];
+      p.reward = obs.member_rewards[i];
+      p.distance_to_exit_m = obs.member_exit_m[i];
+      pending_[obs.member_ids[i]] = std::move(p);
     }
   }
   return out;
@@ -287,7 +344,8 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
 void RsuController::closePending(const Observation& obs) {
   double sum = 0.0;
   for (const Closure& c : obs.closures) {
-    const Pending& p = pending_.at(c.id);
+    const auto in_limbo = limbo_.find(c.id);
+    const Pending& p = in_limbo != limbo_.end() ? in_limbo->second : pending_.at(c.id);
     agent_.remember(p.state, p.decision, static_cast<float>(c.reward), c.next_state, c.done);
     sum += c.reward;
   }
@@ -313,9 +371,31 @@ void RsuController::runGradientSteps() {
   if (gradient_credit_ < 0.0) gradient_credit_ = 0.0;  // absorb the tolerance
 }
 
+void RsuController::observeStep(const RoadSnapshot& snapshot) {
+  if (!options_.train || !options_.reward_over_period || pending_.empty()) return;
+  if (snapshot.num_lanes != options_.num_lanes)
+    throw std::invalid_argument("RsuController::observeStep: snapshot num_lanes = " +
+                                std::to_string(snapshot.num_lanes) + ", this RSU has " +
+                                std::to_string(options_.num_lanes));
+  const NeighbourFinder finder(snapshot);  // validates; throws before anything changes
+  const ClusterStats stats = computeClusterSummary(snapshot, options_.x_start_m, options_.x_end_m,
+                                                   options_.reward.v_bar_max)
+                                 .toClusterStats();
+  std::vector<std::string> ids;
+  for (const VehicleSnapshot& v : snapshot.vehicles)
+    if (pending_.count(v.id) > 0 && (v.lane >= 1 || v.on_accel_lane)) ids.push_back(v.id);
+  const std::vector<double> rewards = rewardsOf(finder, ids, stats, options_.reward);
+  for (size_t i = 0; i < ids.size(); ++i) {
+    Pending& p = pending_.at(ids[i]);
+    p.period_reward_sum += rewards[i];
+    p.period_steps++;
+  }
+}
+
 void RsuController::endEpisode() {
-  stats_.pending_dropped += pending_.size();
+  stats_.pending_dropped += pending_.size() + limbo_.size();
   pending_.clear();
+  limbo_.clear();
   have_last_step_ = false;
 }
 

@@ -337,6 +337,11 @@ TEST(RsuController, ExitArrivalAndDisappearanceAreTerminalWithoutPenalty) {
     if (kind == 0) events.exited = {"a"};
     if (kind == 1) events.arrived = {"a"};  // kind 2: simply gone from the snapshot
     c.decide(road({}), 2, 0.2, GLOBAL, events);
+    // Gone without an event: its event may still be on its way; closed one decision later.
+    if (kind == 2) {
+      EXPECT_EQ(c.agent().replay().size(), 0u);
+      c.decide(road({}), 3, 0.3, GLOBAL, NONE);
+    }
     const ReplayBatch t = onlyTransition(c);
     EXPECT_EQ(t.dones(0), 1.0f) << kind;
     EXPECT_NEAR(t.rewards(0), R_SLOW, 1e-6) << kind;  // the reward at its last observation
@@ -344,18 +349,79 @@ TEST(RsuController, ExitArrivalAndDisappearanceAreTerminalWithoutPenalty) {
   }
 }
 
-TEST(RsuController, CavOnItsOffRampIsTerminalWithItsCurrentReward) {
-  const RsuControllerOptions o = smallOptions();
+TEST(RsuController, VanishedCavGetsTheCollisionPenaltyOfALateEvent) {
+  RsuControllerOptions o = smallOptions();
+  o.collision_penalty = 5.0;
   RsuController c(o);
   c.decide(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE);
-  VehicleSnapshot off = cav("a", 0, 930.0, 15.0);
-  off.lateral_m = -3.0;
-  const RoadSnapshot now = road({off});
-  c.decide(now, 2, 0.2, GLOBAL, NONE);
+  c.decide(road({}), 2, 0.2, GLOBAL, NONE);  // gone; its COLLISION event comes later
+  VehicleOutcomes late;
+  late.collided = {"a"};
+  c.decide(road({}), 3, 0.3, GLOBAL, late);
   const ReplayBatch t = onlyTransition(c);
   EXPECT_EQ(t.dones(0), 1.0f);
-  EXPECT_NEAR(t.rewards(0), rewardOf(o, now, "a"), 1e-6);
-  EXPECT_GT(std::abs(rewardOf(o, now, "a") - R_SLOW), 1e-3);  // not the old reward
+  EXPECT_NEAR(t.rewards(0), R_SLOW - 5.0, 1e-6);
+}
+
+TEST(RsuController, CavOnItsOffRampIsTheExitTakenWithoutWaitingForTheEvent) {
+  for (double bonus : {0.0, 2.0}) {
+    RsuControllerOptions o = smallOptions();
+    o.exit_taken_bonus = bonus;
+    RsuController c(o);
+    c.decide(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE);
+    VehicleSnapshot off = cav("a", 0, 930.0, 15.0);
+    off.lateral_m = -3.0;
+    c.decide(road({off}), 2, 0.2, GLOBAL, NONE);  // EXIT_OK not received yet
+    const ReplayBatch t = onlyTransition(c);
+    EXPECT_EQ(t.dones(0), 1.0f);
+    // The reward of its last mainline observation (the off-ramp's own situation says
+    // nothing about the decision) plus the bonus.
+    EXPECT_NEAR(t.rewards(0), R_SLOW + bonus, 1e-6);
+  }
+}
+
+TEST(RsuController, PassingTheExitIsPenalisedAndTerminalWhenAsked) {
+  for (bool ours : {false, true}) {
+    RsuControllerOptions o = smallOptions();
+    if (ours) {
+      o.exit_missed_penalty = 10.0;
+      o.exit_missed_terminal = true;
+    }
+    RsuController c(o);
+    VehicleSnapshot before = cav("a", 3, 900.0);
+    before.distance_to_exit_m = 20.0;
+    c.decide(road({before}), 1, 0.1, GLOBAL, NONE);
+    const RoadSnapshot after = road({cav("a", 3, 933.5)});  // past its off-ramp: d = +inf
+    c.decide(after, 2, 0.2, GLOBAL, NONE);               // no EXIT_MISSED event needed
+    const ReplayBatch t = onlyTransition(c);
+    EXPECT_EQ(t.dones(0), ours ? 1.0f : 0.0f);
+    EXPECT_NEAR(t.rewards(0), rewardOf(o, after, "a") - (ours ? 10.0 : 0.0), 1e-6);
+  }
+}
+
+TEST(RsuController, FailedMergeIsPenalised) {
+  RsuControllerOptions o = smallOptions();
+  o.merge_failed_penalty = 5.0;
+  RsuController c(o);
+  c.decide(road({cav("a", 1, 900.0)}), 1, 0.1, GLOBAL, NONE);
+  VehicleOutcomes events;
+  events.merge_failed = {"a"};
+  c.decide(road({cav("a", 1, 900.0)}), 2, 0.2, GLOBAL, events);
+  EXPECT_NEAR(onlyTransition(c).rewards(0), R_FAST - 5.0, 1e-6);
+}
+
+TEST(RsuController, RewardOverThePeriodIsTheMeanOfItsSteps) {
+  for (bool over_period : {false, true}) {
+    RsuControllerOptions o = smallOptions();
+    o.reward_over_period = over_period;
+    RsuController c(o);
+    c.decide(road({cav("a", 1, 900.0)}), 10, 1.0, GLOBAL, NONE);
+    c.observeStep(road({cav("a", 1, 902.0, 20.0, 1.0)}));  // two steps between: slow, fast
+    c.observeStep(road({cav("a", 1, 904.0)}));
+    c.decide(road({cav("a", 1, 906.0)}), 20, 2.0, GLOBAL, NONE);
+    const double expected = over_period ? (R_SLOW + R_FAST + R_FAST) / 3.0 : R_FAST;
+    EXPECT_NEAR(onlyTransition(c).rewards(0), expected, 1e-6) << over_period;
+  }
 }
 
 TEST(RsuController, MissedExitAndUnknownIdsChangeNothing) {

@@ -10,6 +10,7 @@
 #include <palcas_msgs/VehicleStateArray.h>
 #include <ros/ros.h>
 
+#include <future>
 #include <limits>
 #include <memory>
 #include <string>
@@ -48,6 +49,10 @@ class RsuNode {
   ros::NodeHandle nh_, private_nh_;
   RsuNodeOptions options_;
   std::unique_ptr<RsuController> controller_;
+  // The running learn() of the last decision (learner_thread); joinLearner() before any
+  // other use of controller_.
+  std::future<void> learner_;
+  void joinLearner();
   PeerStates peers_;
   VehicleOutcomes outcomes_;
 

@@ -17,6 +17,10 @@ struct RsuNodeOptions {
   std::vector<double> zones_m;
   bool whole_road = false;           ///< centralized baseline: one zone over every cluster
   int decision_period_steps = 1;     ///< bridge steps between decisions
+  /// true: a decision's gradient steps run on a worker thread while the simulation goes
+  /// on, joined before the next decision (same result as inline: the next decision sees
+  /// the same weights). false: inline, after publishing the advisories.
+  bool learner_thread = false;
   std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
   std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
   bool resume = false;               ///< continue from the checkpoint in checkpoint_dir

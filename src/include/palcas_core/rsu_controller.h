@@ -43,6 +43,21 @@ struct RsuControllerOptions {
   /// Subtracted from the last reward of a CAV removed by a COLLISION or TELEPORT event
   /// (>= 0, finite). Default 0: the paper defines no terminal penalty.
   double collision_penalty = 0.0;
+  // Terminal outcomes (the paper defines none; src/doc/rsu.md "Terminal transitions").
+  // Each is >= 0 and finite; 0 and false are the paper's behaviour.
+  /// Added to the transition that ends on the CAV's own off-ramp (exit taken; terminal).
+  double exit_taken_bonus = 0.0;
+  /// Subtracted from the transition in which a CAV passed its off-ramp without taking it.
+  double exit_missed_penalty = 0.0;
+  /// true: that transition is terminal (the task of reaching the exit ended, failed); the
+  /// CAV's later decisions are new episodes of a through vehicle. false: it goes on.
+  bool exit_missed_terminal = false;
+  /// Subtracted from the transition in which a merging CAV failed (MERGE_FAILED event).
+  double merge_failed_penalty = 0.0;
+  /// true: a transition's reward is the mean of the per-step rewards over the period the
+  /// decision held (every bridge step up to the next decision, fed by observeStep()).
+  /// false (paper): the reward of the one snapshot at the next decision.
+  bool reward_over_period = false;
   RewardParams reward;  ///< paper reward constants
   StateScales scales;   ///< state normalisation
   PdqnConfig pdqn;      ///< agent hyper-parameters (seed included)
@@ -59,7 +74,8 @@ struct VehicleOutcomes {
   std::vector<std::string> teleported;   ///< TELEPORT: removed; terminal with penalty
   std::vector<std::string> arrived;      ///< ARRIVED: left at its route's end; terminal
   std::vector<std::string> exited;       ///< EXIT_OK: on its own off-ramp; terminal
-  std::vector<std::string> exit_missed;  ///< EXIT_MISSED: still on the road; not terminal
+  std::vector<std::string> exit_missed;  ///< EXIT_MISSED: still on the road
+  std::vector<std::string> merge_failed; ///< MERGE_FAILED: penalised, not terminal
 
   /// Files `id` under the list of `kind`; DEPARTED, MERGE_OK and MERGE_FAILED are ignored
   /// (they end nothing). Never throws except std::bad_alloc.
@@ -135,7 +151,13 @@ class RsuController {
   DecisionOutput advise(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                         const GlobalDensities& global, const VehicleOutcomes& outcomes);
   /// The gradient steps due after one decision (train mode; nothing in eval mode).
+  /// Touches only the agent: a node may run it on another thread while it calls
+  /// observeStep(), and must join it before the next advise()/decide() or any other call.
   void learn();
+  /// A bridge step between two decisions (train mode, reward_over_period): adds every
+  /// pending CAV's reward at this step to its period mean. Never touches the agent.
+  /// Throws std::invalid_argument like advise() on a malformed snapshot (nothing changed).
+  void observeStep(const RoadSnapshot& snapshot);
 
   /// Drops the pending transitions without storing them (an episode cut by the simulation
   /// end is not a terminal state) and forgets the previous step.
@@ -186,6 +208,17 @@ class RsuController {
     nn::Vector state;
     Decision decision;
     double reward = 0.0;  ///< reward at that observation (for terminal transitions)
+    double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
+    double period_reward_sum = 0.0;   ///< rewards of the steps since (reward_over_period)
+    int period_steps = 0;
+    /// The reward the transition gets: the period mean including `now` when kept.
+    double periodReward(double now, bool over_period) const {
+      return over_period ? (period_reward_sum + now) / (period_steps + 1) : now;
+    }
+    /// Mean reward since the decision, or the decision's own when no step was seen.
+    double lastReward() const {
+      return period_steps > 0 ? period_reward_sum / period_steps : reward;
+    }
   };
   struct Observation;  // everything decide() computes before changing any state
 
@@ -198,6 +231,9 @@ class RsuController {
   StateBuilder builder_;
   PdqnAgent agent_;
   std::map<std::string, Pending> pending_;  // ordered: transitions are stored by id
+  // Vanished without an event: its COLLISION / ARRIVED event may still be on its way
+  // (another topic), so the transition is closed one decision later.
+  std::map<std::string, Pending> limbo_;
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
   double gradient_credit_ = 0.0;
