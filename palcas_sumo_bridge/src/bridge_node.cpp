@@ -120,10 +120,9 @@ void BridgeNode::publishStep() {
   current_states_.num_lanes = static_cast<uint8_t>(session_->road().numMainLanes());
   current_states_.vehicles.clear();
   for (const sim::VehicleRecord& v : session_->vehicles()) current_states_.vehicles.push_back(toMsg(v));
-  lockstep_->beginStep(step);
-  states_pub_.publish(current_states_);
-
-  // Measure from the published state only, so a bag of the episode reproduces it.
+  // Measure from the published state only, so a bag of the episode reproduces it. The
+  // events of a step go out before its states: an RSU then usually has them when it
+  // decides (it does not rely on it: see RsuController's limbo).
   const auto& sim_events = session_->lastEvents();
   const std::vector<metrics::VehicleEvent> events = measure_->onStep(
       current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
@@ -135,6 +134,8 @@ void BridgeNode::publishStep() {
     for (const auto& e : events) msg.events.push_back(toMsg(e));
     events_pub_.publish(msg);
   }
+  lockstep_->beginStep(step);
+  states_pub_.publish(current_states_);
   if (options_.publish_tf && tf_pub_.getNumSubscribers() > 0)
     tf_pub_.publish(markers_->transforms(stamp, session_->vehicles()));
 }
@@ -253,7 +254,7 @@ void BridgeNode::applyAdvisories() {
     }
     if (!advised.count(it->first) &&
         (late_this_step_.count(it->second.rsu_id) || step >= it->second.step + hold))
-      session_->holdSpeed(it->first);
+      session_->endCommand(it->first);
     ++it;
   }
   late_this_step_.clear();
@@ -332,6 +333,8 @@ void BridgeNode::runEpisode(int episode) {
         measure_->metrics().rejections(static_cast<metrics::RejectionReason>(r));
   summary.timing = timer;
   summary.decision_ms = decision_ms_;
+  summary.lane_changes_done = session_->laneChangesDone();
+  summary.lane_changes_dropped = session_->laneChangesDropped();
   writeMetricsJson(options_, summary, episode);
   ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
            options_.first_episode + options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());

@@ -46,6 +46,8 @@ struct RunSummary {
   StepTimer timing;
   /// RSU decision latencies (AdvisoryArray.decision_ms of answers that advised) [ms].
   std::vector<float> decision_ms;
+  /// Advised lane changes finished / dropped for want of a safe gap within their time.
+  std::uint64_t lane_changes_done = 0, lane_changes_dropped = 0;
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

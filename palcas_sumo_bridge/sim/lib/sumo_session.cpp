@@ -258,7 +258,8 @@ void SumoSession::onDeparted(const std::string& id) {
   api::Vehicle::subscribe(id, vehicleVariables());
   if (v.is_cav && options_.advisory_control) {
     api::Vehicle::setSpeedMode(id, options_.cav_speed_mode);
-    api::Vehicle::setLaneChangeMode(id, options_.cav_lane_change_mode);
+    v.merge_mode = options_.own_merge && v.entry_cluster >= 0;  // ramp CAVs start on a ramp
+    api::Vehicle::setLaneChangeMode(id, options_.cav_lane_change_mode | (v.merge_mode ? 1 : 0));
     // Controlled CAVs drive towards the mainline end; the bridge switches the target to the
     // off-ramp only once the CAV is in lane 1 just before it, so a CAV that does not get
     // there in time really misses its exit (SUMO's strategic changes are off).
@@ -290,7 +291,10 @@ void SumoSession::readVehicles() {
     v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
     updateDerived(v);
     if (v.lane_change_target != 0) continueLaneChange(v);
-    if (v.is_cav && options_.advisory_control) manageExit(v);
+    if (v.is_cav && options_.advisory_control) {
+      manageExit(v);
+      if (v.merge_mode) updateMergeMode(v);
+    }
   }
 }
 
@@ -340,6 +344,14 @@ void SumoSession::manageExit(VehicleRecord& v) {
   }
 }
 
+void SumoSession::updateMergeMode(VehicleRecord& v) {
+  // Strategic changes only until the CAV is on a mainline lane: from then on lane changes
+  // (exits included) are the RSUs' job.
+  if (v.part != RoadPart::kMainline || v.lane < 1) return;
+  api::Vehicle::setLaneChangeMode(v.id, options_.cav_lane_change_mode);
+  v.merge_mode = false;
+}
+
 void SumoSession::requestLaneChange(VehicleRecord& v, double duration_s) {
   const int index = road_->sumoLaneIndex(v.edge, v.lane_change_target);
   if (index < 0) {  // the target lane does not exist on this edge (e.g. the road narrows)
@@ -375,7 +387,9 @@ bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
 
 void SumoSession::continueLaneChange(VehicleRecord& v) {
   if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
-    v.lane_change_target = 0;  // done, or aborted after lane_change_duration_s
+    // Done, or dropped after lane_change_duration_s (no safe gap found in time).
+    ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
+    v.lane_change_target = 0;
     return;
   }
   if (v.edge != v.lane_change_edge && wholeOnEdge(v))
@@ -398,36 +412,38 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();
     if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
-    v.command = HeldCommand::kKeepSpeed;
+    v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;
   } else if (action == ACCELERATE) {
     v.command = HeldCommand::kAccelerate;
     v.command_value = accel_mps2;
   } else if (action == KEEP) {
-    v.command = HeldCommand::kKeepSpeed;
+    v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;
   } else {
     throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
   }
 }
 
-void SumoSession::holdSpeed(const std::string& id) {
+void SumoSession::endCommand(const std::string& id) {
   auto it = index_.find(id);
   if (it == index_.end()) return;
   VehicleRecord& v = vehicles_[it->second];
   if (v.part == RoadPart::kOffRamp) return;
-  v.command = HeldCommand::kKeepSpeed;
+  v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
   v.command_value = v.speed_mps;
 }
 
 void SumoSession::applyHeldCommand(VehicleRecord& v) {
-  if (v.command == HeldCommand::kNone) return;
-  if (v.part == RoadPart::kOffRamp) {
-    // Left the mainline: SUMO drives it from here. Release once.
-    api::Vehicle::setSpeed(v.id, -1.0);
+  if (v.command == HeldCommand::kNone || v.part == RoadPart::kOffRamp) {
+    // SUMO's own car following drives it (no command, or it left the mainline): release
+    // our last setSpeed once.
+    if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
+    v.speed_overridden = false;
     v.command = HeldCommand::kNone;
     return;
   }
+  v.speed_overridden = true;
   if (v.command == HeldCommand::kKeepSpeed) {
     api::Vehicle::setSpeed(v.id, v.command_value);
   } else {

@@ -17,7 +17,7 @@ using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
 
 namespace {
-constexpr int LANE_LEFT = 0, KEEP = 3;
+constexpr int LANE_LEFT = 0, ACCELERATE = 2, KEEP = 3;
 
 SessionOptions tinyOptions() {
   palcas::sim::ScenarioConfig c;
@@ -33,7 +33,17 @@ SessionOptions tinyOptions() {
                  "--time-to-teleport.remove", "true"};
   o.cluster_length_m = 300.0;
   o.advisory_control = true;
+  o.own_car_following = true;  // what config/bridge.yaml ships
+  o.own_merge = true;
+  o.cav_lane_change_mode = 1536;
   return o;
+}
+// The lane-change model checks the others' gaps (cav_lane_change_mode 1536): pick a CAV
+// with nobody in lane 2 from 80 m behind to 40 m ahead.
+bool leftLaneFree(const SumoSession& session, const VehicleRecord& ego) {
+  for (const VehicleRecord& o : session.vehicles())
+    if (o.lane == 2 && o.x_m > ego.x_m - 80.0 && o.x_m < ego.x_m + 40.0) return false;
+  return true;
 }
 }  // namespace
 
@@ -47,8 +57,9 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
   for (int i = 0; i < 3000 && mover.empty(); ++i) {
     session.step();
     for (const VehicleRecord& v : session.vehicles())
-    if (v.part == RoadPart::kMainline && v.lane == 1 && v.lane_pos_m > v.length_m + 1.0 &&
-        v.edge.find("merge") == std::string::npos && v.speed_mps > 3.0 && v.x_m < 200.0)
+      if (v.part == RoadPart::kMainline && v.lane == 1 && v.lane_pos_m > v.length_m + 1.0 &&
+          v.edge.find("merge") == std::string::npos && v.speed_mps > 3.0 && v.x_m < 200.0 &&
+          leftLaneFree(session, v))
         mover = v.id;
   }
   ASSERT_FALSE(mover.empty()) << "no moving CAV on lane 1";
@@ -58,8 +69,35 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
     changed = changed || (session.find(mover) && session.find(mover)->lane == 2);
   }
   EXPECT_TRUE(changed) << mover << " did not reach lane 2 within 2.5 s";
+  EXPECT_GE(session.laneChangesDone(), 1u);
 
-  // 2. Advisories the session cannot apply are refused, naming the problem.
+  // 2. Own car following: ACCELERATE brakes for its hold; once the command ends the CAV's
+  // own model speeds it up again (a frozen speed would stay where the braking left it).
+  std::string braker;
+  for (const VehicleRecord& v : session.vehicles())
+    if (v.part == RoadPart::kMainline && v.speed_mps > 15.0 && v.x_m < 150.0) braker = v.id;
+  ASSERT_FALSE(braker.empty()) << "no fast CAV near the start";
+  const double v0 = session.find(braker)->speed_mps;
+  session.applyAdvisory(braker, ACCELERATE, -3.0);
+  for (int i = 0; i < 10 && session.find(braker); ++i) session.step();
+  ASSERT_NE(session.find(braker), nullptr);
+  const double braked = session.find(braker)->speed_mps;
+  EXPECT_LT(braked, v0 - 2.0) << braker;
+  session.endCommand(braker);
+  for (int i = 0; i < 20 && session.find(braker); ++i) session.step();
+  if (session.find(braker)) EXPECT_GT(session.find(braker)->speed_mps, braked + 1.0) << braker;
+
+  // 3. Own merge: CAVs from the on-ramps reach the mainline without any advisory.
+  bool merged = false;
+  for (int i = 0; i < 1500 && !merged; ++i) {
+    session.step();
+    for (const VehicleRecord& v : session.vehicles())
+      merged = merged || (v.entry_cluster >= 0 && v.part == RoadPart::kMainline && v.lane >= 1 &&
+                          v.id != mover && v.id != braker);
+  }
+  EXPECT_TRUE(merged) << "no ramp CAV merged by itself";
+
+  // 4. Advisories the session cannot apply are refused, naming the problem.
   EXPECT_THROW(session.applyAdvisory("no_such_vehicle", KEEP, 0.0), std::invalid_argument);
   for (const VehicleRecord& v : session.vehicles())
     if (v.part == RoadPart::kMainline && v.lane == 3 && session.road().hasEdge(v.edge)) {

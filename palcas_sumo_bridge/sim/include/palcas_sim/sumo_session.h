@@ -36,6 +36,15 @@ struct SessionOptions {
   /// lanes and a CAV can miss its exit); advised changes avoid immediate collisions only.
   int cav_lane_change_mode = 256;
   double lane_change_duration_s = 2.0;  ///< an advised lane change not done by then is dropped
+  /// true: a CAV's own car-following model (SUMO's) drives it longitudinally whenever no
+  /// ACCELERATE command holds: with no advisory, under KEEP, during an advised lane change
+  /// and when a command expires. false (the paper's literal a3 "maintain the current
+  /// cruising speed"): KEEP and lane changes freeze the current speed until the next command.
+  bool own_car_following = false;
+  /// true: a CAV on an acceleration lane may make SUMO's strategic change onto the mainline
+  /// by itself (bit 0 of the lane-change mode, only while on that lane): finishing a merge
+  /// is part of its own automation. false: only an advised LEFT merges it.
+  bool own_merge = false;
 };
 
 /// One vehicle on the road, updated every step.
@@ -73,6 +82,8 @@ struct VehicleRecord {
   HeldCommand command = HeldCommand::kNone;
   double command_value = 0.0;  ///< held speed [m/s] or acceleration [m/s^2]
   bool exit_committed = false; ///< SUMO target switched to its off-ramp
+  bool speed_overridden = false; ///< a setSpeed of ours is in force (else SUMO's own model)
+  bool merge_mode = false;       ///< strategic lane changes allowed (own_merge, accel lane)
   /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
   /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
   /// differ (a merge edge), until the target lane is reached or the time is up.
@@ -126,9 +137,15 @@ class SumoSession {
   /// is held; ACCELERATE holds `accel_mps2`; KEEP holds the current speed.
   /// @throws std::invalid_argument for an unknown vehicle or a lane that does not exist.
   void applyAdvisory(const std::string& id, int action, double accel_mps2);
-  /// A controlled CAV that received no advisory this step keeps its current speed (not on
-  /// an off-ramp, where SUMO drives it again).
-  void holdSpeed(const std::string& id);
+  /// The command of a controlled CAV ended (expired, or its RSU is late or lost): with
+  /// own_car_following SUMO's model drives it again, else it keeps its current speed (not on
+  /// an off-ramp, where SUMO drives it again). Unknown ids are ignored.
+  void endCommand(const std::string& id);
+
+  /// Advised lane changes finished in the target lane / dropped because they could not be
+  /// made within lane_change_duration_s (the lane-change model found no safe gap).
+  std::uint64_t laneChangesDone() const { return lane_changes_done_; }
+  std::uint64_t laneChangesDropped() const { return lane_changes_dropped_; }
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -145,6 +162,7 @@ class SumoSession {
   bool wholeOnEdge(const VehicleRecord& v) const;
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
+  void updateMergeMode(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
 
   SessionOptions options_;
@@ -161,6 +179,7 @@ class SumoSession {
   std::unordered_map<std::string, std::size_t> index_;
   StepEvents events_;
   bool open_ = false;
+  std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0;
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
