@@ -1,0 +1,85 @@
+#!/usr/bin/env bash
+# Command-line checks of ./palcas: a bad option of `run` or `train` is refused with exit
+# status 2 and a message naming the option, before anything is installed, built or created.
+# Needs no build. `./palcas test` runs it and counts its JUnit file with the other tests.
+#
+#   test/cli/palcas_cli_test.sh [--xml FILE]
+set -uo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+XML=""
+if [ "${1:-}" = --xml ]; then
+  [ $# -ge 2 ] || { echo "palcas_cli_test: --xml needs a file" >&2; exit 2; }
+  XML="$2"
+fi
+WORK="$(mktemp -d)"
+export PALCAS_RESULTS_DIR="$WORK/results"  # where a default run or training folder would go
+OUT="$WORK/out"                            # the --out of every check
+
+names=() failures=()
+
+xml_escape() {
+  local s="${1//&/&amp;}"
+  s="${s//</&lt;}"; s="${s//>/&gt;}"; s="${s//\"/&quot;}"
+  printf '%s' "${s//$'\n'/ }"
+}
+
+finish() {
+  [ ${#names[@]} -gt 0 ] || { names+=(no_check_ran); failures+=("the script stopped before its first check"); }
+  local failed=0 i
+  for i in "${!names[@]}"; do [ -z "${failures[$i]}" ] || failed=$((failed + 1)); done
+  if [ -n "$XML" ]; then
+    mkdir -p "$(dirname "$XML")"
+    {
+      printf '<?xml version="1.0" encoding="UTF-8"?>\n'
+      printf '<testsuite name="palcas_cli" tests="%d" failures="%d" errors="0">\n' "${#names[@]}" "$failed"
+      for i in "${!names[@]}"; do
+        if [ -z "${failures[$i]}" ]; then
+          printf '  <testcase classname="palcas_cli" name="%s"/>\n' "${names[$i]}"
+        else
+          printf '  <testcase classname="palcas_cli" name="%s"><failure message="%s"/></testcase>\n' \
+            "${names[$i]}" "$(xml_escape "${failures[$i]}")"
+        fi
+      done
+      printf '</testsuite>\n'
+    } >"$XML"
+  fi
+  rm -rf "$WORK"
+  echo "palcas_cli: $((${#names[@]} - failed)) passed, $failed failed"
+  [ "$failed" -eq 0 ] && exit 0 || exit 1
+}
+trap 'finish' EXIT
+
+# check NAME EXPECTED_TEXT ARGS...: ./palcas ARGS exits 2, names EXPECTED_TEXT on stderr,
+# and creates neither a results folder nor --out.
+check() {
+  local name="$1" expect="$2"; shift 2
+  local err status=0 why=""
+  # A time limit: if the check regressed, ./palcas would go on to build and run.
+  err="$(cd "$WORK" && timeout -k 5 60 "$ROOT/palcas" "$@" 2>&1 >/dev/null)" || status=$?
+  if [ "$status" -eq 124 ] || [ "$status" -eq 137 ]; then
+    why="did not stop within 60 s (it went past the checks)"
+  elif [ "$status" -ne 2 ]; then
+    why="exit status $status, expected 2; stderr: $err"
+  elif [[ "$err" != *"$expect"* ]]; then
+    why="stderr does not contain \"$expect\": $err"
+  elif [[ "$err" == *"building the workspace"* ]]; then
+    why="started a build: $err"
+  elif [ -e "$PALCAS_RESULTS_DIR" ] || [ -e "$OUT" ]; then
+    why="created a results folder"
+  fi
+  rm -rf "$PALCAS_RESULTS_DIR" "$OUT"
+  names+=("$name"); failures+=("$why")
+  if [ -z "$why" ]; then echo "ok   $name"; else echo "FAIL $name: $why"; fi
+}
+
+check run_pr_out_of_range      "--pr '150'"                 run --out "$OUT" --pr 150
+check run_seed_not_an_integer  "--seed 'x'"                 run --out "$OUT" --seed x
+check run_duration_not_positive "--duration '0'"            run --out "$OUT" --duration 0
+check run_scenario_unknown     "--scenario 'nope'"          run --out "$OUT" --scenario nope
+check run_policy_missing       "--policy '/nonexistent'"    run --out "$OUT" --policy /nonexistent
+check run_arm_unknown          "--arm 'bogus'"              run --out "$OUT" --arm bogus
+check run_pr_without_value     "option --pr needs a value"  run --out "$OUT" --pr
+check train_arm_keep           "--arm keep"                 train --out "$OUT" --arm keep
+check train_episodes_zero      "--episodes '0'"             train --out "$OUT" --episodes 0
+check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed
