@@ -88,6 +88,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
       p.number("lane_change_duration", o.session.lane_change_duration_s, 0.1, 60.0);
   o.session.own_car_following = p.get<bool>("own_car_following", o.session.own_car_following);
   o.session.own_merge = p.get<bool>("own_merge", o.session.own_merge);
+  o.session.remove_collided = p.get<bool>("remove_collided", o.session.remove_collided);
   o.session.cluster_length_m = o.scenario.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
   o.lockstep_deadline_s = p.number("lockstep_deadline", o.lockstep_deadline_s, 0.001, 60.0);

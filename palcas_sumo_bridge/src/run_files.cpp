@@ -85,6 +85,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"lane_change_duration_s", o.session.lane_change_duration_s},
           {"own_car_following", o.session.own_car_following},
           {"own_merge", o.session.own_merge},
+          {"remove_collided", o.session.remove_collided},
           {"expected_rsus", o.expected_rsus},
           {"lockstep_deadline_s", o.lockstep_deadline_s},
           {"lost_after_missed_steps", o.lost_after_missed_steps},
@@ -176,6 +177,8 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   // readable, on demand into the run folder (and the console).
   if (o.sumo_warnings) s.sumo_args.insert(s.sumo_args.end(), {"--log", o.out_dir + "/sumo.log"});
   else s.sumo_args.insert(s.sumo_args.end(), {"--no-warnings", "true"});
+  // SUMO 1.15 crashes removing collided vehicles itself; the session removes them.
+  if (s.remove_collided) s.sumo_args.insert(s.sumo_args.end(), {"--collision.action", "warn"});
   s.sumo_binary = o.gui ? "sumo-gui" : "sumo";
   if (o.gui) s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", "true"});
   return s;

@@ -218,12 +218,34 @@ const StepEvents& SumoSession::step() {
   events_.arrived = asStringList(sim, libsumo::VAR_ARRIVED_VEHICLES_IDS);
   events_.collided = asStringList(sim, libsumo::VAR_COLLIDING_VEHICLES_IDS);
   events_.teleported = asStringList(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS);
-  // Colliding vehicles are removed by SUMO (collision.action remove) and may also be
-  // listed as arrived; each leaves once.
+  // A vehicle colliding on two lanes at once is listed twice.
+  std::sort(events_.collided.begin(), events_.collided.end());
+  events_.collided.erase(std::unique(events_.collided.begin(), events_.collided.end()),
+                         events_.collided.end());
+  if (options_.remove_collided) {
+    for (const std::string& id : events_.collided) {
+      try {
+        api::Vehicle::remove(id, libsumo::REMOVE_VAPORIZED);
+      } catch (const std::exception&) {
+        // Already gone (e.g. it arrived in the same step): nothing to remove.
+      }
+    }
+  }
+  // Colliding vehicles are removed (by SUMO or above) and may also be listed as arrived,
+  // now or in the next step; each leaves once, and only vehicles still tracked arrive.
   for (const std::string& id : events_.collided) removeVehicle(id, &events_.removed);
   for (const std::string& id : events_.teleported) removeVehicle(id, &events_.removed);
+  events_.arrived.erase(std::remove_if(events_.arrived.begin(), events_.arrived.end(),
+                                       [this](const std::string& id) { return !index_.count(id); }),
+                        events_.arrived.end());
   for (const std::string& id : events_.arrived) removeVehicle(id, &events_.removed);
-  for (const std::string& id : events_.departed) onDeparted(id);
+  for (const std::string& id : events_.departed) {
+    // A vehicle that collided in the step it departed in was removed above.
+    if (options_.remove_collided &&
+        std::binary_search(events_.collided.begin(), events_.collided.end(), id))
+      continue;
+    onDeparted(id);
+  }
   readVehicles();
   return events_;
 }

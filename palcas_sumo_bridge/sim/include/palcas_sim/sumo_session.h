@@ -45,6 +45,12 @@ struct SessionOptions {
   /// by itself (bit 0 of the lane-change mode, only while on that lane): finishing a merge
   /// is part of its own automation. false: only an advised LEFT merges it.
   bool own_merge = false;
+  /// true: colliding vehicles are removed by the session through Vehicle::remove right after
+  /// the step, SUMO itself only reporting them (its args must include --collision.action
+  /// warn). SUMO 1.15's own removal (collision.action remove) leaves a vehicle caught mid
+  /// lane change registered on its neighbour lane: it aborts in getBackPositionOnLane or
+  /// frees the vehicle twice (SIGSEGV in removePending), fixed only in SUMO 1.17.
+  bool remove_collided = false;
 };
 
 /// One vehicle on the road, updated every step.
