@@ -207,7 +207,20 @@ const VehicleRecord* SumoSession::find(const std::string& id) const {
 }
 
 const StepEvents& SumoSession::step() {
-  for (VehicleRecord& v : vehicles_) applyHeldCommand(v);
+  std::vector<std::string> vanished;
+  for (VehicleRecord& v : vehicles_) {
+    try {
+      applyHeldCommand(v);
+    } catch (const libsumo::TraCIException& e) {
+      // SUMO no longer knows it (removed without a report we read): forget it instead of
+      // ending the simulation. Counted; the reason goes to stderr once per vehicle.
+      std::fprintf(stderr, "[palcas sumo t=%.1f] %s vanished from SUMO (edge %s, x %.1f): %s\n",
+                   time_s_, v.id.c_str(), v.edge.c_str(), v.x_m, e.what());
+      vanished.push_back(v.id);
+    }
+  }
+  for (const std::string& id : vanished) removeVehicle(id, nullptr);
+  vanished_vehicles_ += vanished.size();
   api::Simulation::step();
   ++step_count_;
   time_s_ = api::Simulation::getTime();
@@ -225,6 +238,9 @@ const StepEvents& SumoSession::step() {
   if (options_.remove_collided) {
     for (const std::string& id : events_.collided) {
       try {
+        // Its subscription first: libsumo would otherwise still serve it at the next
+        // step and fail there on a vehicle it no longer knows.
+        if (index_.count(id)) api::Vehicle::unsubscribe(id);
         api::Vehicle::remove(id, libsumo::REMOVE_VAPORIZED);
       } catch (const std::exception&) {
         // Already gone (e.g. it arrived in the same step): nothing to remove.

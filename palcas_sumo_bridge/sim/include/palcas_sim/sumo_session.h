@@ -152,6 +152,8 @@ class SumoSession {
   /// made within lane_change_duration_s (the lane-change model found no safe gap).
   std::uint64_t laneChangesDone() const { return lane_changes_done_; }
   std::uint64_t laneChangesDropped() const { return lane_changes_dropped_; }
+  /// Tracked vehicles SUMO no longer knew when a command was applied (forgotten, not fatal).
+  std::uint64_t vanishedVehicles() const { return vanished_vehicles_; }
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -185,7 +187,7 @@ class SumoSession {
   std::unordered_map<std::string, std::size_t> index_;
   StepEvents events_;
   bool open_ = false;
-  std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0;
+  std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
