@@ -1,0 +1,103 @@
+#!/usr/bin/env bash
+# Learning regression test: a seeded ./palcas train on the tiny road (10 episodes x 300 s,
+# a small network, about 3 minutes) must beat the keep arm (advisories on, all KEEP) on an
+# evaluation seed it never trained on: DSR at least MARGIN points above keep's while the
+# traffic keeps at least SPEED_SHARE of keep's average speed (a policy that gets CAVs out
+# by jamming the road does not count). The same training with learning switched off
+# (learning rate 0: config/training/no_learning.yaml) must not. Asserts on simulated
+# outcomes only, never on wall-clock time.
+#
+#   test/learning/learning_regression_test.sh [--xml FILE] [--keep-work]
+set -uo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+XML="" KEEP_WORK=false
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --xml) XML="$2"; shift 2 ;;
+    --keep-work) KEEP_WORK=true; shift ;;
+    *) echo "learning_regression_test: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+MARGIN=20          # DSR points above keep a learnt policy must reach
+SPEED_SHARE=0.9    # of keep's average speed (all vehicles) it must keep
+TRAIN_SEED=1       # episodes use seeds 1..10
+EVAL_SEED=101      # never used in training
+WORK="$(mktemp -d)"
+export PALCAS_NO_BUILD=1  # ./palcas test built the workspace already
+names=() failures=()
+
+# "DSR SPEED" of a run folder's metrics.json.
+outcome() {
+  /usr/bin/python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); print(m["dsr_pct"], m["efficiency_all_mps"])' "$1"
+}
+
+# train_and_compare NAME LEARNING_FILE: trains, evaluates beside keep, prints
+# "policy_dsr policy_speed keep_dsr keep_speed".
+train_and_compare() {
+  local name="$1" learning="$2"
+  "$ROOT/palcas" train --scenario tiny --episodes 10 --duration 300 --seed "$TRAIN_SEED" \
+    --learning "$learning" --rsu-params "$ROOT/config/training/short_rsu.yaml" \
+    --out "$WORK/$name/train" >"$WORK/$name.train.log" 2>&1 || return 1
+  "$ROOT/palcas" run --policy "$WORK/$name/train" --scenario tiny --duration 300 --seed "$EVAL_SEED" \
+    --out "$WORK/$name/eval" >"$WORK/$name.eval.log" 2>&1 || return 1
+  echo "$(outcome "$WORK/$name/eval/palcas/metrics.json") $(outcome "$WORK/$name/eval/keep/metrics.json")"
+}
+
+is_number() { [[ "$1" =~ ^[0-9]+(\.[0-9]+)?$ ]]; }
+
+record() {  # NAME FAILURE("" = passed)
+  names+=("$1"); failures+=("$2")
+  if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
+}
+
+# beats POLICY_DSR POLICY_SPEED KEEP_DSR KEEP_SPEED: the policy beats keep as defined above.
+beats() {
+  for v in "$@"; do is_number "$v" || return 2; done
+  awk -v p="$1" -v ps="$2" -v k="$3" -v ks="$4" -v m="$MARGIN" -v share="$SPEED_SHARE" \
+    'BEGIN { exit !(p >= k + m && ps >= share * ks) }'
+}
+
+read -r dsr speed keep_dsr keep_speed < <(train_and_compare learning "$ROOT/config/training/tiny_fast_learning.yaml" || echo "nan nan nan nan")
+echo "learning on:  policy DSR $dsr % at $speed m/s; keep DSR $keep_dsr % at $keep_speed m/s (eval seed $EVAL_SEED)"
+if beats "$dsr" "$speed" "$keep_dsr" "$keep_speed"; then
+  record trained_policy_beats_keep ""
+else
+  record trained_policy_beats_keep "DSR $dsr % at $speed m/s vs keep $keep_dsr % at $keep_speed m/s: needs keep + $MARGIN points at >= $SPEED_SHARE x its speed (logs: $WORK)"
+  KEEP_WORK=true
+fi
+
+read -r dsr0 speed0 keep_dsr0 keep_speed0 < <(train_and_compare no_learning "$ROOT/config/training/no_learning.yaml" || echo "nan nan nan nan")
+echo "learning off: policy DSR $dsr0 % at $speed0 m/s; keep DSR $keep_dsr0 % at $keep_speed0 m/s"
+beats "$dsr0" "$speed0" "$keep_dsr0" "$keep_speed0"; verdict=$?
+if [ "$verdict" -eq 1 ]; then
+  record untrained_policy_does_not ""
+elif [ "$verdict" -eq 2 ]; then
+  record untrained_policy_does_not "the learning-off run failed (logs: $WORK)"
+  KEEP_WORK=true
+else
+  record untrained_policy_does_not "learning rate 0 gave DSR $dsr0 % at $speed0 m/s vs keep $keep_dsr0 % at $keep_speed0 m/s: the test does not measure learning"
+  KEEP_WORK=true
+fi
+
+failed=0
+for f in "${failures[@]}"; do [ -z "$f" ] || failed=$((failed + 1)); done
+if [ -n "$XML" ]; then
+  mkdir -p "$(dirname "$XML")"
+  {
+    printf '<?xml version="1.0" encoding="UTF-8"?>\n'
+    printf '<testsuite name="palcas_learning" tests="%d" failures="%d" errors="0">\n' "${#names[@]}" "$failed"
+    for i in "${!names[@]}"; do
+      if [ -z "${failures[$i]}" ]; then
+        printf '  <testcase classname="palcas_learning" name="%s"/>\n' "${names[$i]}"
+      else
+        printf '  <testcase classname="palcas_learning" name="%s"><failure message="%s"/></testcase>\n' \
+          "${names[$i]}" "$(printf '%s' "${failures[$i]}" | sed 's/&/\&amp;/g; s/</\&lt;/g; s/"/\&quot;/g')"
+      fi
+    done
+    printf '</testsuite>\n'
+  } >"$XML"
+fi
+[ "$KEEP_WORK" = true ] && echo "work folder kept: $WORK" || rm -rf "$WORK"
+echo "palcas_learning: $((${#names[@]} - failed)) passed, $failed failed"
+[ "$failed" -eq 0 ]
