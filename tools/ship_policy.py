@@ -1,0 +1,78 @@
+#!/usr/bin/env python3
+"""Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
+global model, the training record and its curves; not the replay-laden checkpoints.
+
+usage: ship_policy.py TRAIN_DIR DEST_DIR
+
+DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
+checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
+TRAINING.md: command, commit, wall time, simulated hours, seeds, episodes."""
+import csv
+import json
+import pathlib
+import shutil
+import sys
+
+
+def main(train_dir, dest):
+    src = pathlib.Path(train_dir).resolve()
+    dst = pathlib.Path(dest)
+    train = json.loads((src / "train.json").read_text())
+    if dst.exists():
+        shutil.rmtree(dst)
+    (dst / "checkpoints").mkdir(parents=True)
+    global_model = src / "checkpoints/fedserver/global_model.palcas"
+    if global_model.exists():  # federated arms: the server's global model
+        (dst / "checkpoints/fedserver").mkdir()
+        shutil.copy2(global_model, dst / "checkpoints/fedserver/")
+        for f in ("federation_state.json",):
+            if (src / "checkpoints/fedserver" / f).exists():
+                shutil.copy2(src / "checkpoints/fedserver" / f, dst / "checkpoints/fedserver/")
+    else:  # independent / centralized: one model per RSU
+        for model in sorted(src.glob("checkpoints/*/model.palcas")):
+            (dst / "checkpoints" / model.parent.name).mkdir()
+            shutil.copy2(model, dst / "checkpoints" / model.parent.name)
+    for csv_file in sorted(src.glob("checkpoints/*/learning.csv")):
+        (dst / "checkpoints" / csv_file.parent.name).mkdir(exist_ok=True)
+        shutil.copy2(csv_file, dst / "checkpoints" / csv_file.parent.name)
+    for f in ("episodes.csv", "learning_curves.csv", "learning_curves.png", "aborted_episodes.txt"):
+        if (src / f).exists():
+            shutil.copy2(src / f, dst / f)
+    learning = train.get("learning", "")
+    if learning:  # the override travels with the policy, referred to by its file name
+        shutil.copy2(learning, dst / pathlib.Path(learning).name)
+        train["learning"] = pathlib.Path(learning).name
+    train["shipped_from"] = src.name
+    (dst / "train.json").write_text(json.dumps(train) + "\n")
+
+    rows = list(csv.DictReader(open(src / "episodes.csv")))
+    sim_s = sum(float(r["sim_seconds"]) for r in rows)
+    wall_s = sum(float(r["wall_seconds"]) for r in rows)
+    seeds = [int(r["seed"]) for r in rows]
+    aborted = (src / "aborted_episodes.txt").read_text().splitlines() if (src / "aborted_episodes.txt").exists() else []
+    manifest = json.loads((src / "manifest.json").read_text()) if (src / "manifest.json").exists() else {}
+    lines = [
+        f"# Training record of this policy ({train['arm']})",
+        "",
+        f"- command: `{manifest.get('command_line', '(unknown)')}`",
+        f"- road {train['scenario']}, PR {train['pr']} %, {train['episodes']} x {train['duration_s']:.0f} s, "
+        f"exploration over {100 * float(train.get('explore_fraction', 0.5)):.0f} % of the budget"
+        + (", paper as printed" if train.get("paper_printed") else ", config/departures.yaml"),
+        f"- commit: `{manifest.get('git_commit') or train.get('git_commit', 'unknown')}`",
+        f"- episodes completed: {len(rows)} of {train['episodes']} (training seeds {min(seeds)}..{max(seeds)}; "
+        f"evaluate on other seeds, e.g. 101-103)",
+        f"- simulated: {sim_s / 3600:.2f} h; wall time inside the simulations: {wall_s / 60:.1f} min "
+        f"(real-time factor {sim_s / wall_s:.1f}x)",
+        f"- episodes ended early and not counted: {len(aborted)}" + ("".join("\n  - " + a for a in aborted)),
+        "- files: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads), "
+        "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
+        "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
+    ]
+    (dst / "TRAINING.md").write_text("\n".join(lines) + "\n")
+    print(f"shipped {src} -> {dst}")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    main(sys.argv[1], sys.argv[2])
