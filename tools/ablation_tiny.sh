@@ -2,8 +2,8 @@
 # What each departure from the printed paper buys, measured the way the learning regression
 # test measures learning: for every file of config/training/ablations/ (one departure set
 # back to the paper's value) plus "ours" (none) and "paper_printed" (all of them, bridge
-# included), a seeded training on the tiny road (10 x 300 s, small network) and a greedy
-# evaluation on an unseen seed. Prints a Markdown table; folders stay in OUT.
+# included), a seeded training on the tiny road (16 x 300 s, small network) and a greedy
+# 600 s evaluation on an unseen seed (101), beside keep. Prints a Markdown table; folders stay in OUT.
 #
 #   tools/ablation_tiny.sh OUT [NAME ...]     (default: every ablation)
 set -uo pipefail
@@ -35,10 +35,10 @@ PY
   rsu=(--rsu-params "$ROOT/config/training/short_rsu.yaml")
   [[ " ${extra[*]:-} " == *" --rsu-params "* ]] && rsu=()
   rm -rf "$OUT/$name"
-  "$ROOT/palcas" train --scenario tiny --episodes 10 --duration 300 --seed 1 \
+  "$ROOT/palcas" train --scenario tiny --episodes 16 --duration 300 --seed 1 \
     --learning "$ROOT/config/training/tiny_fast_learning.yaml" "${rsu[@]}" "${extra[@]}" \
     --out "$OUT/$name/train" >"$OUT/$name.log" 2>&1
-  "$ROOT/palcas" run --policy "$OUT/$name/train" --scenario tiny --duration 300 --seed 101 \
+  "$ROOT/palcas" run --policy "$OUT/$name/train" --scenario tiny --duration 600 --seed 101 \
     --out "$OUT/$name/eval" >>"$OUT/$name.log" 2>&1
 done
 /usr/bin/python3 - "$OUT" "${names[@]}" <<'PY'
