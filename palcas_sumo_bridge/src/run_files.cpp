@@ -177,8 +177,6 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   // readable, on demand into the run folder (and the console).
   if (o.sumo_warnings) s.sumo_args.insert(s.sumo_args.end(), {"--log", o.out_dir + "/sumo.log"});
   else s.sumo_args.insert(s.sumo_args.end(), {"--no-warnings", "true"});
-  // SUMO 1.15 crashes removing collided vehicles itself; the session removes them.
-  if (s.remove_collided) s.sumo_args.insert(s.sumo_args.end(), {"--collision.action", "warn"});
   s.sumo_binary = o.gui ? "sumo-gui" : "sumo";
   if (o.gui) s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", "true"});
   return s;

@@ -10,7 +10,7 @@ using palcas::bridge::loadBridgeOptions;
 
 TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   const auto o = loadBridgeOptions(ros::NodeHandle("~paper"));
-  EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 3200.0);  // paper
+  EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 1000.0);  // calibrated (README, departures)
   EXPECT_DOUBLE_EQ(o.scenario.onramp_flow_vphpl, 600.0);     // paper
   EXPECT_DOUBLE_EQ(o.scenario.cluster_length_m, 800.0);      // paper
   EXPECT_DOUBLE_EQ(o.scenario.step_length_s, 0.1);
@@ -20,8 +20,18 @@ TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   EXPECT_DOUBLE_EQ(o.session.cluster_length_m, 800.0);
   EXPECT_DOUBLE_EQ(o.session.lane_change_duration_s, 2.0);  // paper
   EXPECT_DOUBLE_EQ(o.comfort_threshold_mps2, 1.47);         // paper
-  EXPECT_EQ(o.session.cav_lane_change_mode, 256);
+  EXPECT_EQ(o.session.cav_lane_change_mode, 1536);
+  EXPECT_TRUE(o.session.own_car_following);
+  EXPECT_TRUE(o.session.own_merge);
+  EXPECT_TRUE(o.session.remove_collided);
   EXPECT_EQ(o.out_dir, "/tmp/palcas_config_test");
+}
+
+TEST(ConfigFiles, PrintedDemandScenarioLoads) {
+  const auto o = loadBridgeOptions(ros::NodeHandle("~paper_printed"));
+  EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 3200.0);  // paper, as printed
+  EXPECT_DOUBLE_EQ(o.scenario.onramp_flow_vphpl, 600.0);     // paper
+  EXPECT_DOUBLE_EQ(o.scenario.cluster_length_m, 800.0);
 }
 
 TEST(ConfigFiles, TinyScenarioLoads) {
@@ -37,6 +47,9 @@ TEST(ConfigFiles, YamlDefaultsEqualTheStructDefaults) {
   const palcas::bridge::BridgeOptions d;
   EXPECT_EQ(o.session.cav_speed_mode, d.session.cav_speed_mode);
   EXPECT_EQ(o.session.cav_lane_change_mode, d.session.cav_lane_change_mode);
+  EXPECT_EQ(o.session.own_car_following, d.session.own_car_following);
+  EXPECT_EQ(o.session.own_merge, d.session.own_merge);
+  EXPECT_EQ(o.session.remove_collided, d.session.remove_collided);
   EXPECT_DOUBLE_EQ(o.lockstep_deadline_s, d.lockstep_deadline_s);
   EXPECT_EQ(o.lost_after_missed_steps, d.lost_after_missed_steps);
   EXPECT_EQ(o.advisory_hold_steps, d.advisory_hold_steps);

@@ -7,6 +7,8 @@
 set -uo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+# shellcheck source=../junit.sh
+source "$ROOT/test/junit.sh"
 XML=""
 if [ "${1:-}" = --xml ]; then
   [ $# -ge 2 ] || { echo "palcas_cli_test: --xml needs a file" >&2; exit 2; }
@@ -18,32 +20,10 @@ OUT="$WORK/out"                            # the --out of every check
 
 names=() failures=()
 
-xml_escape() {
-  local s="${1//&/&amp;}"
-  s="${s//</&lt;}"; s="${s//>/&gt;}"; s="${s//\"/&quot;}"
-  printf '%s' "${s//$'\n'/ }"
-}
-
 finish() {
   [ ${#names[@]} -gt 0 ] || { names+=(no_check_ran); failures+=("the script stopped before its first check"); }
-  local failed=0 i
-  for i in "${!names[@]}"; do [ -z "${failures[$i]}" ] || failed=$((failed + 1)); done
-  if [ -n "$XML" ]; then
-    mkdir -p "$(dirname "$XML")"
-    {
-      printf '<?xml version="1.0" encoding="UTF-8"?>\n'
-      printf '<testsuite name="palcas_cli" tests="%d" failures="%d" errors="0">\n' "${#names[@]}" "$failed"
-      for i in "${!names[@]}"; do
-        if [ -z "${failures[$i]}" ]; then
-          printf '  <testcase classname="palcas_cli" name="%s"/>\n' "${names[$i]}"
-        else
-          printf '  <testcase classname="palcas_cli" name="%s"><failure message="%s"/></testcase>\n' \
-            "${names[$i]}" "$(xml_escape "${failures[$i]}")"
-        fi
-      done
-      printf '</testsuite>\n'
-    } >"$XML"
-  fi
+  local failed
+  failed="$(write_junit palcas_cli "$XML")"
   rm -rf "$WORK"
   echo "palcas_cli: $((${#names[@]} - failed)) passed, $failed failed"
   [ "$failed" -eq 0 ] && exit 0 || exit 1

@@ -11,6 +11,8 @@
 set -uo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+# shellcheck source=../junit.sh
+source "$ROOT/test/junit.sh"
 XML="" KEEP_WORK=false
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -80,24 +82,7 @@ else
   KEEP_WORK=true
 fi
 
-failed=0
-for f in "${failures[@]}"; do [ -z "$f" ] || failed=$((failed + 1)); done
-if [ -n "$XML" ]; then
-  mkdir -p "$(dirname "$XML")"
-  {
-    printf '<?xml version="1.0" encoding="UTF-8"?>\n'
-    printf '<testsuite name="palcas_learning" tests="%d" failures="%d" errors="0">\n' "${#names[@]}" "$failed"
-    for i in "${!names[@]}"; do
-      if [ -z "${failures[$i]}" ]; then
-        printf '  <testcase classname="palcas_learning" name="%s"/>\n' "${names[$i]}"
-      else
-        printf '  <testcase classname="palcas_learning" name="%s"><failure message="%s"/></testcase>\n' \
-          "${names[$i]}" "$(printf '%s' "${failures[$i]}" | sed 's/&/\&amp;/g; s/</\&lt;/g; s/"/\&quot;/g')"
-      fi
-    done
-    printf '</testsuite>\n'
-  } >"$XML"
-fi
+failed="$(write_junit palcas_learning "$XML")"
 [ "$KEEP_WORK" = true ] && echo "work folder kept: $WORK" || rm -rf "$WORK"
 echo "palcas_learning: $((${#names[@]} - failed)) passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -119,6 +119,8 @@ SumoSession::SumoSession(const SessionOptions& options) : options_(options) {
   cmd[0] = "sumo";  // in-process: the binary name is only argv[0]
 #endif
   cmd.insert(cmd.end(), options_.sumo_args.begin(), options_.sumo_args.end());
+  // SUMO only reports collisions; step() removes the colliding vehicles (remove_collided).
+  if (options_.remove_collided) cmd.insert(cmd.end(), {"--collision.action", "warn"});
   try {
 #ifdef PALCAS_USE_LIBTRACI
     api::Simulation::start(cmd, options_.traci_port);

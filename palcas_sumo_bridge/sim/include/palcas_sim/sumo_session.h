@@ -31,26 +31,26 @@ struct SessionOptions {
   /// SUMO speed-mode bits for CAVs under advisory control (31 = SUMO keeps its safe-speed,
   /// acceleration and right-of-way checks; 30 lets advisories override the safe speed).
   int cav_speed_mode = 31;
-  /// SUMO lane-change-mode bits for CAVs under advisory control. 256 = no strategic,
+  /// SUMO lane-change-mode bits for CAVs under advisory control. 1536 = no strategic,
   /// cooperative, speed-gain or keep-right changes of its own (so only advisories change
-  /// lanes and a CAV can miss its exit); advised changes avoid immediate collisions only.
-  int cav_lane_change_mode = 256;
+  /// lanes and a CAV can miss its exit); advised changes respect the others' gaps; SL2015
+  /// keeps its lateral alignment. 256 (the paper's reading): immediate collisions only.
+  int cav_lane_change_mode = 1536;
   double lane_change_duration_s = 2.0;  ///< an advised lane change not done by then is dropped
   /// true: a CAV's own car-following model (SUMO's) drives it longitudinally whenever no
   /// ACCELERATE command holds: with no advisory, under KEEP, during an advised lane change
   /// and when a command expires. false (the paper's literal a3 "maintain the current
   /// cruising speed"): KEEP and lane changes freeze the current speed until the next command.
-  bool own_car_following = false;
+  bool own_car_following = true;
   /// true: a CAV on an acceleration lane may make SUMO's strategic change onto the mainline
   /// by itself (bit 0 of the lane-change mode, only while on that lane): finishing a merge
   /// is part of its own automation. false: only an advised LEFT merges it.
-  bool own_merge = false;
+  bool own_merge = true;
   /// true: colliding vehicles are removed by the session through Vehicle::remove right after
-  /// the step, SUMO itself only reporting them (its args must include --collision.action
-  /// warn). SUMO 1.15's own removal (collision.action remove) leaves a vehicle caught mid
+  /// the step, SUMO itself only reporting them (the session adds --collision.action warn). SUMO 1.15's own removal (collision.action remove) leaves a vehicle caught mid
   /// lane change registered on its neighbour lane: it aborts in getBackPositionOnLane or
   /// frees the vehicle twice (SIGSEGV in removePending), fixed only in SUMO 1.17.
-  bool remove_collided = false;
+  bool remove_collided = true;
 };
 
 /// One vehicle on the road, updated every step.
