@@ -2,7 +2,10 @@
 """Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
-usage: ship_policy.py TRAIN_DIR DEST_DIR
+usage: ship_policy.py [--rsu-models] TRAIN_DIR DEST_DIR
+
+--rsu-models: ship each RSU's own final model (checkpoints/<rsu>/model.palcas: the last
+global model it loaded plus its local steps since) instead of the server's global model.
 
 DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
 checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
@@ -14,7 +17,7 @@ import shutil
 import sys
 
 
-def main(train_dir, dest):
+def main(train_dir, dest, rsu_models=False):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = json.loads((src / "train.json").read_text())
@@ -22,13 +25,13 @@ def main(train_dir, dest):
         shutil.rmtree(dst)
     (dst / "checkpoints").mkdir(parents=True)
     global_model = src / "checkpoints/fedserver/global_model.palcas"
-    if global_model.exists():  # federated arms: the server's global model
+    if global_model.exists() and not rsu_models:  # federated arms: the server's global model
         (dst / "checkpoints/fedserver").mkdir()
         shutil.copy2(global_model, dst / "checkpoints/fedserver/")
         for f in ("federation_state.json",):
             if (src / "checkpoints/fedserver" / f).exists():
                 shutil.copy2(src / "checkpoints/fedserver" / f, dst / "checkpoints/fedserver/")
-    else:  # independent / centralized: one model per RSU
+    else:  # independent / centralized, or --rsu-models: one model per RSU
         for model in sorted(src.glob("checkpoints/*/model.palcas")):
             (dst / "checkpoints" / model.parent.name).mkdir()
             shutil.copy2(model, dst / "checkpoints" / model.parent.name)
@@ -43,6 +46,7 @@ def main(train_dir, dest):
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name
     train["shipped_from"] = src.name
+    train["shipped_models"] = "rsu" if rsu_models or not global_model.exists() else "global"
     (dst / "train.json").write_text(json.dumps(train) + "\n")
 
     rows = list(csv.DictReader(open(src / "episodes.csv")))
@@ -64,7 +68,10 @@ def main(train_dir, dest):
         f"- simulated: {sim_s / 3600:.2f} h; wall time inside the simulations: {wall_s / 60:.1f} min "
         f"(real-time factor {sim_s / wall_s:.1f}x)",
         f"- episodes ended early and not counted: {len(aborted)}" + ("".join("\n  - " + a for a in aborted)),
-        "- files: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads), "
+        ("- models: each RSU's own final model, `checkpoints/<rsu>/model.palcas` (its zone's RSU loads it)"
+         if train["shipped_models"] == "rsu" else
+         "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
+        "- files: "
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
     ]
@@ -73,6 +80,7 @@ def main(train_dir, dest):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    args = [a for a in sys.argv[1:] if a != "--rsu-models"]
+    if len(args) != 2:
         sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2])
+    main(args[0], args[1], rsu_models="--rsu-models" in sys.argv[1:])
