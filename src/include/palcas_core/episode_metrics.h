@@ -1,5 +1,5 @@
 #pragma once
-// Running measures of one episode (paper, "Simulation Results"; DESIGN.md §7): efficiency,
+// Running measures of one episode (paper, "Simulation Results"): efficiency,
 // CR, DSR, MSR, comfort share and the counters of palcas_msgs/EpisodeMetrics, from speed /
 // acceleration samples, VehicleEvents and bridge counters. Deterministic in what it is fed,
 // so a recorded bag reproduces the live numbers. Rules: src/doc/metrics.md.

@@ -2,7 +2,7 @@
 // Turns per-step vehicle observations and SUMO's removal lists into VehicleEvents: who
 // entered, who left by its own off-ramp or passed it, who merged from an on-ramp or stopped
 // at the end of the acceleration lane, who collided or was teleported (paper, "Simulation
-// Results"; DESIGN.md §7). Decision rules and their reasons: src/doc/metrics.md.
+// Results"). Decision rules and their reasons: src/doc/metrics.md.
 
 #include <cstddef>
 #include <string>

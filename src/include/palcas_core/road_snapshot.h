@@ -3,7 +3,7 @@
 // every vehicle, its cluster, and the other clusters (I2I). Filled from
 // palcas_msgs/VehicleStateArray and ClusterState by the RSU's conversion module.
 //
-// Conventions (DESIGN.md §3): lanes counted the paper's way, 1 = rightmost (exit) lane ..
+// Conventions (README.md, "Conventions"): lanes counted the paper's way, 1 = rightmost (exit) lane ..
 // L = leftmost, 0 = not on a mainline lane (on-ramp, acceleration lane, off-ramp);
 // x = metres along the mainline from its start; SI units.
 

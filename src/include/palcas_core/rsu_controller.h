@@ -1,5 +1,5 @@
 #pragma once
-// One RSU's decisions and learning, without ROS (paper "Design of PALCAS"; DESIGN.md §6).
+// One RSU's decisions and learning, without ROS (paper "Design of PALCAS").
 // The palcas_rsu node is a thin shell around RsuController: it converts messages to a
 // RoadSnapshot, decides WHEN to call decide(), publishes the result, and runs the
 // federation exchange. Behaviour, choices and their reasons: src/doc/rsu.md.

@@ -1,5 +1,5 @@
 #pragma once
-// Builds the normalised per-CAV state vectors (paper "State Space"; DESIGN.md §6), one
+// Builds the normalised per-CAV state vectors (paper "State Space"), one
 // column per CAV, from a road snapshot, the cluster statistics and the I2I densities.
 // Layout: state_layout.h; table, scales and encodings: src/doc/state_and_reward.md.
 

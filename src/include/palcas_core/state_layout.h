@@ -1,5 +1,5 @@
 #pragma once
-// Named indices of the per-CAV state vector (paper "State Space"; DESIGN.md §6), in the
+// Named indices of the per-CAV state vector (paper "State Space"), in the
 // style of robot_localization's filter_common.h. The full table with normalisation and
 // missing-value encodings is in src/doc/state_and_reward.md.
 //

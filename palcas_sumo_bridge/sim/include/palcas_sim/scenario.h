@@ -1,5 +1,5 @@
 #pragma once
-// The paper's SUMO scenario (paper "Simulation Setup"; DESIGN.md section 5): network generation
+// The paper's SUMO scenario (paper "Simulation Setup"): network generation
 // from the plain XML sources in config/scenarios/<name>/ with netconvert, the demand (vehicle
 // types, routes, flows) and the .sumocfg. Layout, naming and every parameter's reason:
 // config/scenarios/README.md; the defaults mirrored as YAML: config/scenarios/paper/scenario.yaml.
