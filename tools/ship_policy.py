@@ -25,12 +25,12 @@ def main(train_dir, dest, rsu_models=False):
         shutil.rmtree(dst)
     (dst / "checkpoints").mkdir(parents=True)
     global_model = src / "checkpoints/fedserver/global_model.palcas"
-    if global_model.exists() and not rsu_models:  # federated arms: the server's global model
+    state = src / "checkpoints/fedserver/federation_state.json"
+    if state.exists():  # the rounds the training closed (reported beside evaluations)
         (dst / "checkpoints/fedserver").mkdir()
+        shutil.copy2(state, dst / "checkpoints/fedserver/")
+    if global_model.exists() and not rsu_models:  # federated arms: the server's global model
         shutil.copy2(global_model, dst / "checkpoints/fedserver/")
-        for f in ("federation_state.json",):
-            if (src / "checkpoints/fedserver" / f).exists():
-                shutil.copy2(src / "checkpoints/fedserver" / f, dst / "checkpoints/fedserver/")
     else:  # independent / centralized, or --rsu-models: one model per RSU
         for model in sorted(src.glob("checkpoints/*/model.palcas")):
             (dst / "checkpoints" / model.parent.name).mkdir()
