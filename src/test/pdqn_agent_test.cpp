@@ -452,6 +452,26 @@ TEST(PdqnDepartures, ParamLossCanUseTheAccelerateHeadOnly) {
   }
 }
 
+TEST(PdqnDepartures, RejectsBadDepartureSettingsNamingThem) {
+  auto rejected = [](PdqnConfig c, const std::string& field) {
+    try {
+      PdqnAgent agent(c);
+      ADD_FAILURE() << "accepted a bad " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  PdqnConfig c = smallConfig();
+  c.target_soft_tau = 1.5f;
+  rejected(c, "target_soft_tau");
+  c = smallConfig();
+  c.epsilon_linear_rounds = -1.0;
+  rejected(c, "epsilon_linear_rounds");
+  c = smallConfig();  // state size 5: no ego-lane feature of a 40 + L layout to mask by
+  c.td_target_valid_actions = true;
+  rejected(c, "state_size");
+}
+
 TEST(PdqnDepartures, LinearEpsilonReachesItsFloorAfterTheStatedRounds) {
   PdqnConfig c = smallConfig();
   c.epsilon_start = 1.0;

@@ -158,6 +158,10 @@ TEST(RsuControllerOptions, RejectsBadFieldsNamingThem) {
   bad([](auto& o) { o.gradient_steps_per_decision = -0.5; }, "gradient_steps_per_decision");
   bad([](auto& o) { o.collision_penalty = NaN; }, "collision_penalty");
   bad([](auto& o) { o.collision_penalty = -1.0; }, "collision_penalty");
+  bad([](auto& o) { o.exit_taken_bonus = -1.0; }, "exit_taken_bonus");
+  bad([](auto& o) { o.exit_taken_bonus = NaN; }, "exit_taken_bonus");
+  bad([](auto& o) { o.exit_missed_penalty = -1.0; }, "exit_missed_penalty");
+  bad([](auto& o) { o.merge_failed_penalty = NaN; }, "merge_failed_penalty");
   bad([](auto& o) { o.num_lanes = 4; }, "pdqn.state_size");  // 40 + 4 = 44 != 45
   bad([](auto& o) { o.reward.rho = NaN; }, "reward");
   bad([](auto& o) { o.scales.speed_mps = 0.0; }, "scales");

@@ -63,3 +63,4 @@ check run_pr_without_value     "option --pr needs a value"  run --out "$OUT" --p
 check train_arm_keep           "--arm keep"                 train --out "$OUT" --arm keep
 check train_episodes_zero      "--episodes '0'"             train --out "$OUT" --episodes 0
 check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed
+check train_explore_fraction_zero "--explore-fraction '0'" train --out "$OUT" --explore-fraction 0
