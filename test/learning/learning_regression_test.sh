@@ -64,7 +64,7 @@ read -r dsr speed keep_dsr keep_speed < <(train_and_compare learning "$ROOT/conf
 echo "learning on:  policy DSR $dsr % at $speed m/s; keep DSR $keep_dsr % at $keep_speed m/s (eval seed $EVAL_SEED)"
 # Trainings are not repeatable to the bit (ROS timing), and about one in five of these short
 # ones ends in a policy that brakes the tiny road into a jam: a second training on other
-# seeds decides then. Learning switched off never came close (1.9–5.2 m/s in five runs).
+# seeds decides then. Learning switched off never came close (1.9–5.2 m/s in four runs).
 if ! beats "$dsr" "$speed" "$keep_dsr" "$keep_speed"; then
   read -r dsr speed keep_dsr keep_speed < <(train_and_compare learning_again "$ROOT/config/training/tiny_fast_learning.yaml" 17 || echo "nan nan nan nan")
   echo "learning on, second training (seeds 17..32): policy DSR $dsr % at $speed m/s; keep DSR $keep_dsr % at $keep_speed m/s"
