@@ -219,7 +219,12 @@ void BridgeNode::applyAdvisories() {
   std::unordered_set<std::string> advised;
   std::vector<std::pair<std::string, int>> advised_actions;
   for (const auto& array : pending_) {
-    if (!array->advisories.empty()) decision_ms_.push_back(array->decision_ms);
+    if (!array->advisories.empty()) {
+      decision_ms_.push_back(array->decision_ms);
+      if (recorder_)
+        recorder_->addDecision(session_->timeS(), array->rsu_id, array->decision_ms,
+                               array->advisories.size());
+    }
     for (const auto& a : array->advisories) {
       const metrics::AdvisoryRequest request = toRequest(a, array->step, array->rsu_id);
       const sim::VehicleRecord* vehicle = session_->find(a.vehicle_id);
@@ -297,6 +302,13 @@ void BridgeNode::runEpisode(int episode) {
   next_metrics_s_ = options_.metrics_period_s;
   const double duration_s = options_.scenario.duration_s;
   StepTimer timer;
+  recorder_.reset();
+  if (options_.trajectory_period_steps > 0) {
+    const bool several = options_.episodes > 1 || options_.first_episode > 0;
+    recorder_ = std::make_unique<sim::RunRecorder>(
+        several ? options_.out_dir + "/episode_" + std::to_string(episode) : options_.out_dir,
+        options_.trajectory_period_steps);
+  }
   publishStep();
   while (ros::ok() && session_->timeS() < duration_s - 1e-9) {
     const auto t_wait = std::chrono::steady_clock::now();
@@ -306,6 +318,7 @@ void BridgeNode::runEpisode(int episode) {
     session_->step();
     const auto t1 = std::chrono::steady_clock::now();
     publishStep();
+    if (recorder_) recorder_->addStep(session_->stepCount(), session_->timeS(), session_->vehicles());
     const auto t2 = std::chrono::steady_clock::now();
     timer.add(session_->vehicles().size(), std::chrono::duration<double>(t1 - t0).count(),
               std::chrono::duration<double>(t2 - t1).count(),
@@ -322,6 +335,7 @@ void BridgeNode::runEpisode(int episode) {
   }
   if (std::abs(session_->timeS() - (next_metrics_s_ - options_.metrics_period_s)) > 1e-9)
     publishMetrics();  // the final state, unless the periodic report just covered it
+  if (recorder_) recorder_->close();
   RunSummary summary;
   summary.episode = episode;
   summary.metrics = measure_->metrics().snapshot();

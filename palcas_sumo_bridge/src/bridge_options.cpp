@@ -88,6 +88,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
       p.number("lane_change_duration", o.session.lane_change_duration_s, 0.1, 60.0);
   o.session.own_car_following = p.get<bool>("own_car_following", o.session.own_car_following);
   o.session.own_merge = p.get<bool>("own_merge", o.session.own_merge);
+  o.session.max_advised_accel_mps2 =
+      p.number("max_advised_accel", o.session.max_advised_accel_mps2, 0.0, 20.0);
   o.session.remove_collided = p.get<bool>("remove_collided", o.session.remove_collided);
   o.session.cluster_length_m = o.scenario.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
@@ -96,6 +98,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.integer("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.integer("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
+  o.trajectory_period_steps =
+      p.integer("trajectory_period_steps", o.trajectory_period_steps, 0, 1000000);
   o.advisory_hold_steps = p.integer("advisory_hold_steps", o.advisory_hold_steps, 1, 1000000);
   o.real_time_factor = p.number("real_time_factor", o.real_time_factor, 0.0, 1000.0);
   o.metrics_period_s = p.number("metrics_period", o.metrics_period_s, 0.1, 1e6);

@@ -85,6 +85,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"lane_change_duration_s", o.session.lane_change_duration_s},
           {"own_car_following", o.session.own_car_following},
           {"own_merge", o.session.own_merge},
+          {"max_advised_accel_mps2", o.session.max_advised_accel_mps2},
           {"remove_collided", o.session.remove_collided},
           {"expected_rsus", o.expected_rsus},
           {"lockstep_deadline_s", o.lockstep_deadline_s},

@@ -23,6 +23,8 @@ TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   EXPECT_EQ(o.session.cav_lane_change_mode, 1536);
   EXPECT_TRUE(o.session.own_car_following);
   EXPECT_TRUE(o.session.own_merge);
+  EXPECT_DOUBLE_EQ(o.session.max_advised_accel_mps2, 1.47);  // departure; paper: 0 (no clip)
+  EXPECT_EQ(o.trajectory_period_steps, 0);
   EXPECT_TRUE(o.session.remove_collided);
   EXPECT_EQ(o.out_dir, "/tmp/palcas_config_test");
 }
@@ -49,6 +51,8 @@ TEST(ConfigFiles, YamlDefaultsEqualTheStructDefaults) {
   EXPECT_EQ(o.session.cav_lane_change_mode, d.session.cav_lane_change_mode);
   EXPECT_EQ(o.session.own_car_following, d.session.own_car_following);
   EXPECT_EQ(o.session.own_merge, d.session.own_merge);
+  EXPECT_DOUBLE_EQ(o.session.max_advised_accel_mps2, d.session.max_advised_accel_mps2);
+  EXPECT_EQ(o.trajectory_period_steps, d.trajectory_period_steps);
   EXPECT_EQ(o.session.remove_collided, d.session.remove_collided);
   EXPECT_DOUBLE_EQ(o.lockstep_deadline_s, d.lockstep_deadline_s);
   EXPECT_EQ(o.lost_after_missed_steps, d.lost_after_missed_steps);

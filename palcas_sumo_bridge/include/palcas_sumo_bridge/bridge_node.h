@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "palcas_sim/lockstep.h"
+#include "palcas_sim/run_recorder.h"
 #include "palcas_sim/sumo_session.h"
 #include "palcas_sumo_bridge/bridge_options.h"
 #include "palcas_sumo_bridge/episode_measure.h"
@@ -63,6 +64,7 @@ class BridgeNode {
   std::unique_ptr<RvizMarkers> markers_;
   MeasureRules rules_;
   std::unique_ptr<EpisodeMeasure> measure_;
+  std::unique_ptr<sim::RunRecorder> recorder_;  ///< trajectories.csv + decisions.csv, if asked
   int episode_ = 0;
 
   ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,

@@ -40,6 +40,9 @@ struct BridgeOptions {
   double real_time_factor = 0.0;   ///< 0 = as fast as possible; e.g. 1.0 = real time
   double metrics_period_s = 10.0;  ///< simulated time between EpisodeMetrics messages [s]
   double linger_s = 1.0;           ///< wall time to stay up after the episode, so subscribers drain [s]
+  /// Record trajectories.csv (every vehicle every N steps) and decisions.csv into the run
+  /// folder (episode_<k>/ when several episodes); 0 = record nothing.
+  int trajectory_period_steps = 0;
   int markers_every_steps = 5;     ///< rviz markers every N steps (only with subscribers)
   bool publish_tf = true;          ///< map -> vehicle and map -> RSU zone frames (only with subscribers)
   // Metrics rules.

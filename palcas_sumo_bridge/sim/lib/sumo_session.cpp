@@ -455,8 +455,12 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;
   } else if (action == ACCELERATE) {
+    if (!std::isfinite(accel_mps2))
+      throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
+                                  std::to_string(accel_mps2));
+    const double limit = options_.max_advised_accel_mps2;
     v.command = HeldCommand::kAccelerate;
-    v.command_value = accel_mps2;
+    v.command_value = limit > 0.0 ? std::clamp(accel_mps2, -limit, limit) : accel_mps2;
   } else if (action == KEEP) {
     v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
     v.command_value = v.speed_mps;

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 
 #include "palcas_sim/scenario.h"
 #include "scenario_test_util.h"
@@ -78,11 +80,13 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
     if (v.part == RoadPart::kMainline && v.speed_mps > 15.0 && v.x_m < 150.0) braker = v.id;
   ASSERT_FALSE(braker.empty()) << "no fast CAV near the start";
   const double v0 = session.find(braker)->speed_mps;
+  // -3 is clipped to the comfort band (max_advised_accel_mps2 1.47, as shipped).
   session.applyAdvisory(braker, ACCELERATE, -3.0);
+  EXPECT_DOUBLE_EQ(session.find(braker)->command_value, -1.47);
   for (int i = 0; i < 10 && session.find(braker); ++i) session.step();
   ASSERT_NE(session.find(braker), nullptr);
   const double braked = session.find(braker)->speed_mps;
-  EXPECT_LT(braked, v0 - 2.0) << braker;
+  EXPECT_LT(braked, v0 - 1.0) << braker;
   session.endCommand(braker);
   for (int i = 0; i < 20 && session.find(braker); ++i) session.step();
   if (session.find(braker)) EXPECT_GT(session.find(braker)->speed_mps, braked + 1.0) << braker;
@@ -105,4 +109,9 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
       break;
     }
   EXPECT_THROW(session.applyAdvisory(session.vehicles().front().id, 9, 0.0), std::invalid_argument);
+  // A NaN acceleration is refused and the vehicle keeps the command it held.
+  const std::string first = session.vehicles().front().id;
+  session.applyAdvisory(first, ACCELERATE, 1.0);
+  EXPECT_THROW(session.applyAdvisory(first, ACCELERATE, std::nan("")), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(session.find(first)->command_value, 1.0);
 }

@@ -46,6 +46,10 @@ struct SessionOptions {
   /// by itself (bit 0 of the lane-change mode, only while on that lane): finishing a merge
   /// is part of its own automation. false: only an advised LEFT merges it.
   bool own_merge = true;
+  /// Largest |acceleration| an ACCELERATE advisory may command [m/s^2]; larger requests are
+  /// clipped to it. 0 = no limit (the paper: the action range [-4.5, 2.6] reaches the car).
+  /// Emergency braking stays with the car-following model underneath (cav_speed_mode 31).
+  double max_advised_accel_mps2 = 1.47;
   /// true: colliding vehicles are removed by the session through Vehicle::remove right after
   /// the step, SUMO itself only reporting them (the session adds --collision.action warn). SUMO 1.15's own removal (collision.action remove) leaves a vehicle caught mid
   /// lane change registered on its neighbour lane: it aborts in getBackPositionOnLane or
