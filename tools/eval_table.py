@@ -10,6 +10,9 @@ import math
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from palcas_stats import format_ci, mean_ci95  # noqa: E402
+
 METRICS = [
     ("dsr_pct", "DSR (%)", 1),
     ("msr_pct", "MSR (%)", 1),
@@ -21,19 +24,6 @@ METRICS = [
     ("lane_changes_dropped", "advised lane changes dropped", 0),
     ("real_time_factor", "real-time factor", 1),
 ]
-# Two-sided 95 % Student-t quantiles by degrees of freedom.
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262}
-
-
-def interval(values):
-    n = len(values)
-    mean = sum(values) / n
-    if n < 2:
-        return mean, float("nan")
-    sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1))
-    return mean, T95.get(n - 1, 1.96) * sd / math.sqrt(n)
-
-
 def main(dirs):
     runs = [pathlib.Path(d) for d in dirs]
     arms = []
@@ -57,8 +47,7 @@ def main(dirs):
             if not vals:
                 cells.append("n/a")
                 continue
-            mean, half = interval(vals)
-            cells.append(f"{mean:.{digits}f} ± {half:.{digits}f}" if math.isfinite(half) else f"{mean:.{digits}f}")
+            cells.append(format_ci(*mean_ci95(vals), digits))
         print(f"| {label} | " + " | ".join(cells) + " |")
     print(f"\n{len(runs)} evaluation run(s): " + ", ".join(r.name for r in runs))
 

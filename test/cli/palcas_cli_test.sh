@@ -64,3 +64,10 @@ check train_arm_keep           "--arm keep"                 train --out "$OUT" -
 check train_episodes_zero      "--episodes '0'"             train --out "$OUT" --episodes 0
 check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed
 check train_explore_fraction_zero "--explore-fraction '0'" train --out "$OUT" --explore-fraction 0
+check run_scenario_wrong_state "its state has 43 features"  run --out "$OUT" --scenario tiny
+check train_bridge_params_missing "--bridge-params '/nonexistent'" train --out "$OUT" --bridge-params /nonexistent
+check experiment_arm_unknown   "--arms: unknown arm 'bogus'" experiment --out "$OUT" --arms keep,bogus
+check experiment_pr_out_of_range "--prs: 150 is outside"    experiment --out "$OUT" --arms keep --prs 5,150
+check experiment_seeds_zero    "--seeds: 0 must be >= 1"     experiment --out "$OUT" --arms keep --seeds 0
+check experiment_policy_wrong_road "trained on road paper"  experiment --out "$OUT" --arms palcas --scenario tiny
+check experiment_without_out   "--out"                       experiment --arms keep

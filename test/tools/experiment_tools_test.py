@@ -1,0 +1,273 @@
+#!/usr/bin/env python3
+"""Tests of the experiment planner and collector (tools/experiment.py,
+tools/experiment_results.py), the interval arithmetic (tools/palcas_stats.py) and the
+figure functions (tools/run_figures.py), on fake run folders and a tiny recorded episode
+(fixtures/tiny_run: 60 s of the tiny road, keep and sumo_native, seed 101).
+
+usage: experiment_tools_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
+import argparse
+import csv
+import json
+import math
+import pathlib
+import shutil
+import sys
+import tempfile
+import unittest
+from xml.sax.saxutils import quoteattr
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+FIXTURE = pathlib.Path(__file__).resolve().parent / "fixtures" / "tiny_run"
+sys.path.insert(0, str(ROOT / "tools"))
+import experiment  # noqa: E402
+import experiment_results  # noqa: E402
+import palcas_stats  # noqa: E402
+import run_figures  # noqa: E402
+
+
+def args(**kw):
+    base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
+                policy=None, jobs=1, check_only=False)
+    base.update(kw)
+    return argparse.Namespace(**base)
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+class IntervalTest(unittest.TestCase):
+    def test_hand_computed_intervals(self):
+        mean, half = palcas_stats.mean_ci95([1.0, 2.0, 3.0])  # sd 1, t(2) = 4.303
+        self.assertAlmostEqual(mean, 2.0)
+        self.assertAlmostEqual(half, 4.303 / math.sqrt(3), places=9)
+        mean, half = palcas_stats.mean_ci95([10.0, 12.0])  # sd sqrt(2), t(1) = 12.706
+        self.assertAlmostEqual(mean, 11.0)
+        self.assertAlmostEqual(half, 12.706, places=9)
+        mean, half = palcas_stats.mean_ci95([5.0, 5.0, 5.0, 5.0])
+        self.assertEqual(half, 0.0)
+
+    def test_edges(self):
+        self.assertTrue(math.isnan(palcas_stats.mean_ci95([4.0])[1]))
+        self.assertEqual(palcas_stats.t975(31), 1.96)
+        self.assertEqual(palcas_stats.t975(30), 2.042)
+        with self.assertRaises(ValueError):
+            palcas_stats.mean_ci95([])
+        with self.assertRaises(ValueError):
+            palcas_stats.mean_ci95([1.0, float("nan")])
+        self.assertEqual(palcas_stats.format_ci(1.234, float("nan"), 1), "1.2")
+        self.assertEqual(palcas_stats.format_ci(1.234, 0.55, 1), "1.2 ± 0.6")
+
+
+class PlannerTest(unittest.TestCase):
+    def setUp(self):
+        self.out = pathlib.Path(tempfile.mkdtemp(prefix="palcas_exp_test_"))
+
+    def tearDown(self):
+        shutil.rmtree(self.out, ignore_errors=True)
+
+    def test_points_plan_and_slurm_array(self):
+        s = experiment.settings_from_args(args())
+        self.assertEqual(s["seeds"], [101, 102])
+        pts = experiment.points_of(s)
+        self.assertEqual(len(pts), 2 * 2 * 2)
+        self.assertEqual(len({p["name"] for p in pts}), 8)
+        self.assertIn("keep_pr60_s102", {p["name"] for p in pts})
+        # Only the first seed records trajectories (the figures' run).
+        self.assertTrue(all(p["trajectories"] == (p["seed"] == 101) for p in pts))
+        experiment.save_settings(self.out, s)
+        self.assertEqual(experiment.write_plan(self.out, s), 8)
+        lines = (self.out / "plan.txt").read_text().splitlines()
+        self.assertEqual(len(lines), 8)
+        self.assertTrue(all("tools/experiment.py point" in line for line in lines))
+        self.assertIn("#SBATCH --array=1-8", (self.out / "slurm_array.sh").read_text())
+
+    def test_bad_options_are_named(self):
+        for kw, text in ((dict(arms="keep,nope"), "nope"), (dict(prs="5,101"), "101"),
+                         (dict(prs="5,5"), "twice"), (dict(seeds=0), "--seeds"),
+                         (dict(duration=0.0), "--duration"), (dict(scenario="nope"), "nope"),
+                         (dict(arms="no_priority", policy=["no_priority=/nonexistent"]), "no trained policy")):
+            with self.assertRaises(experiment.UsageError) as e:
+                experiment.settings_from_args(args(**kw))
+            self.assertIn(text, str(e.exception))
+
+    def test_continuation_extends_but_never_changes_duration(self):
+        s = experiment.settings_from_args(args())
+        experiment.save_settings(self.out, s)
+        with self.assertRaises(experiment.UsageError) as e:
+            experiment.merge_settings(self.out, experiment.settings_from_args(args(duration=900.0)))
+        self.assertIn("duration_s", str(e.exception))
+        merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(prs="60,40")))
+        self.assertEqual(merged["prs"], [5.0, 60.0, 40.0])
+
+
+def fake_point(out, name, arm, sim_seconds, status=None, dsr=None):
+    d = out / "points" / name
+    (d / arm).mkdir(parents=True, exist_ok=True)
+    if sim_seconds is not None:
+        m = {"sim_seconds": sim_seconds, "efficiency_all_mps": 20.0, "collision_rate_pct": 0.0,
+             "dsr_pct": dsr, "msr_pct": 100.0, "comfort_share_pct": 80.0}
+        (d / arm / "metrics.json").write_text(json.dumps(m))
+    if status:
+        (d / "point.json").write_text(json.dumps({"status": status, "wall_s": 10.0,
+                                                  "error": "rsu_0 died" if status == "failed" else ""}))
+
+
+class CollectorTest(unittest.TestCase):
+    def setUp(self):
+        self.out = pathlib.Path(tempfile.mkdtemp(prefix="palcas_collect_test_"))
+        self.s = experiment.settings_from_args(args(arms="keep", prs="60", seeds=4))
+        experiment.save_settings(self.out, self.s)
+        self.pts = experiment.points_of(self.s)
+        fake_point(self.out, "keep_pr60_s101", "keep", 600.0, "done", dsr=30.0)
+        fake_point(self.out, "keep_pr60_s102", "keep", 600.0, None, dsr=40.0)   # ran elsewhere
+        fake_point(self.out, "keep_pr60_s103", "keep", 250.0, None, dsr=99.0)   # interrupted
+        fake_point(self.out, "keep_pr60_s104", "keep", 600.0, "failed", dsr=99.0)
+
+    def tearDown(self):
+        shutil.rmtree(self.out, ignore_errors=True)
+
+    def test_finished_points_are_never_rerun(self):
+        done = {p["name"]: experiment.finished(self.out, p, 600.0) for p in self.pts}
+        self.assertEqual(done, {"keep_pr60_s101": True, "keep_pr60_s102": True,
+                                "keep_pr60_s103": False, "keep_pr60_s104": False})
+
+    def test_tables_count_only_finished_points(self):
+        code = experiment_results.collect(self.out, self.s, self.pts)
+        self.assertEqual(code, 1)  # not every point is in
+        rows = {r["point"]: r for r in read_csv(self.out / "results.csv")}
+        self.assertEqual([rows[n]["status"] for n in sorted(rows)],
+                         ["done", "done", "incomplete", "failed"])
+        self.assertEqual(rows["keep_pr60_s104"]["error"], "rsu_0 died")
+        dsr = read_csv(self.out / "table_dsr_pct.csv")
+        self.assertEqual(len(dsr), 1)
+        self.assertEqual(dsr[0]["n"], "2")
+        self.assertAlmostEqual(float(dsr[0]["mean"]), 35.0)
+        self.assertAlmostEqual(float(dsr[0]["ci95_half"]), 12.706 * math.sqrt(50.0) / math.sqrt(2), places=3)
+        md = (self.out / "tables.md").read_text()
+        self.assertIn("keep_pr60_s103 (incomplete)", md)
+        self.assertIn("keep_pr60_s104 (failed)", md)
+
+    def test_paper_numbers_sit_beside_ours(self):
+        paper = experiment_results.read_paper()
+        self.assertEqual(paper[("palcas", 60.0, "dsr_pct")], (93.97, 3.56))
+        self.assertEqual(paper[("no_priority", 5.0, "collision_rate_pct")], (35.97, 9.65))
+        self.assertEqual(len(paper), 4 * 5 * 4)
+        fake_point(self.out, "palcas_pr60_s101", "palcas", 600.0, "done", dsr=90.0)
+        s = dict(self.s, arms=["palcas", "keep"])
+        experiment_results.collect(self.out, s, experiment.points_of(s))
+        md = (self.out / "tables.md").read_text()
+        self.assertIn("PALCAS, paper", md)
+        self.assertIn("*94.0 ± 3.6*", md)
+
+
+class FiguresTest(unittest.TestCase):
+    def setUp(self):
+        self.out = pathlib.Path(tempfile.mkdtemp(prefix="palcas_fig_test_"))
+        self.trajs = {a: run_figures.read_trajectories(FIXTURE / a / "trajectories.csv")
+                      for a in ("keep", "sumo_native")}
+
+    def tearDown(self):
+        shutil.rmtree(self.out, ignore_errors=True)
+
+    def assertFigure(self, name):
+        self.assertTrue((self.out / f"{name}.png").stat().st_size > 5000, name)
+        return read_csv(self.out / f"{name}.csv")
+
+    def test_speed_over_time(self):
+        run_figures.speed_over_time(self.trajs, str(self.out / "sot"), bin_s=10.0)
+        rows = self.assertFigure("sot")
+        self.assertEqual(list(rows[0]), ["time_s", "keep_mps", "sumo_native_mps"])
+        t = self.trajs["keep"]
+        on = [tt for tt, p in zip(t["time_s"], t["part"]) if p in ("mainline", "accel_lane")]
+        self.assertEqual(len(rows), len({math.floor(tt / 10.0) for tt in on}))  # bins [10k, 10k+10)
+        self.assertTrue(all(0.0 < float(r["keep_mps"]) < 40.0 for r in rows))
+
+    def test_space_time(self):
+        run_figures.space_time(self.trajs["keep"], "keep", str(self.out / "st"), dx_m=50.0, dt_s=10.0)
+        rows = self.assertFigure("st")
+        self.assertTrue(all(float(r["x_start_m"]) % 50.0 == 0.0 for r in rows))
+        self.assertEqual(sum(int(r["samples"]) for r in rows),
+                         int(sum(p in ("mainline", "accel_lane") for p in self.trajs["keep"]["part"])))
+
+    def test_same_vehicle_per_route_in_every_arm(self):
+        picks = run_figures.accel_and_lanes(self.trajs, str(self.out / "acc"), str(self.out / "lanes"))
+        acc = self.assertFigure("acc")
+        lanes = self.assertFigure("lanes")
+        self.assertGreaterEqual(len(picks), 2)
+        for route, vid in picks.items():
+            arms = {r["arm"] for r in acc if r["route"] == route and r["vehicle"] == vid}
+            self.assertEqual(arms, {"keep", "sumo_native"})
+        self.assertTrue(all(int(r["lane"]) >= 1 for r in lanes))
+
+    def test_decision_cdf_marks_percentiles(self):
+        path = self.out / "decisions.csv"
+        with open(path, "w") as f:
+            f.write("time_s,rsu,decision_ms,advisories\n")
+            for i in range(100):
+                f.write(f"{i},rsu_0,{i + 1},3\n{i},rsu_1,{2 * (i + 1)},2\n")
+        self.assertTrue(run_figures.decision_cdf(path, "palcas", str(self.out / "cdf")))
+        rows = {r["rsu"]: r for r in self.assertFigure("cdf")}
+        self.assertEqual(rows["rsu_0"]["decisions"], "100")
+        self.assertAlmostEqual(float(rows["rsu_0"]["p50_ms"]), 50.5)
+        self.assertAlmostEqual(float(rows["rsu_1"]["p99_ms"]), 2 * 99.01, places=2)
+
+    def test_learning_curves_of_every_arm(self):
+        pol = ROOT / "config" / "policies" / "palcas"
+        self.assertTrue(run_figures.learning_curves({"palcas": pol, "copy": pol}, str(self.out / "lc")))
+        rows = self.assertFigure("lc")
+        n = len(read_csv(pol / "episodes.csv"))
+        self.assertEqual(len(rows), 2 * n)
+
+    def test_whole_run_folder(self):
+        pngs = run_figures.figures_for_run(FIXTURE, self.out)
+        names = {pathlib.Path(p).stem for p in pngs}
+        self.assertTrue({"speed_over_time", "space_time_keep", "space_time_sumo_native",
+                         "accel_profiles", "lane_trajectories"} <= names)
+
+
+class JUnitResult(unittest.TextTestResult):
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.cases = []
+
+    def addSuccess(self, test):
+        super().addSuccess(test)
+        self.cases.append((test.id(), None))
+
+    def addFailure(self, test, err):
+        super().addFailure(test, err)
+        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
+
+    def addError(self, test, err):
+        super().addError(test, err)
+        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--xml")
+    a = ap.parse_args()
+    suite = unittest.defaultTestLoader.loadTestsFromModule(sys.modules[__name__])
+    result = unittest.TextTestRunner(resultclass=JUnitResult, verbosity=2).run(suite)
+    if a.xml:
+        pathlib.Path(a.xml).parent.mkdir(parents=True, exist_ok=True)
+        failed = sum(1 for _, f in result.cases if f)
+        with open(a.xml, "w") as f:
+            f.write('<?xml version="1.0" encoding="UTF-8"?>\n')
+            f.write(f'<testsuite name="experiment_tools" tests="{len(result.cases)}" '
+                    f'failures="{failed}" errors="0">\n')
+            for name, failure in result.cases:
+                cls, _, case = name.rpartition(".")
+                if failure:
+                    f.write(f'  <testcase classname={quoteattr(cls)} name={quoteattr(case)}>'
+                            f'<failure message={quoteattr(failure[-500:])}/></testcase>\n')
+                else:
+                    f.write(f'  <testcase classname={quoteattr(cls)} name={quoteattr(case)}/>\n')
+            f.write("</testsuite>\n")
+    sys.exit(0 if result.wasSuccessful() else 1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,425 @@
+#!/usr/bin/env python3
+"""The paper's experiment: arms x PRs x evaluation seeds, each point an independent run.
+
+  experiment.py run     --out DIR [--arms a,b] [--prs 5,10] [--seeds N] [--duration S]
+                        [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
+  experiment.py plan    (same options): write DIR/plan.txt (one command per point) and
+                        DIR/slurm_array.sh, run nothing
+  experiment.py point   --out DIR --name POINT   run one planned point (what plan.txt calls)
+  experiment.py collect --out DIR   results.csv, tables and figures from the point folders
+
+Layout: DIR/experiment.json (the settings; a later call must agree with them), and per point
+DIR/points/<arm>_pr<P>_s<seed>/ with <arm>/metrics.json, manifest.json, console.log and
+point.json (status, exit code, wall time, command). A point is finished when its
+metrics.json covers the whole duration; finished points are never run again, so an
+interrupted experiment continues where it stopped. Called by `./palcas experiment`.
+"""
+import argparse
+import concurrent.futures
+import json
+import os
+import pathlib
+import re
+import shlex
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+import experiment_results  # noqa: E402
+
+LEARNING_ARMS = ("palcas", "centralized", "independent", "no_priority")
+ALL_ARMS = LEARNING_ARMS + ("keep", "sumo_native")
+PAPER_PRS = (5, 10, 20, 40, 60)
+FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..30
+# Settings that define the experiment: a continuation must not change them.
+FIXED_KEYS = ("duration_s", "scenario")
+
+
+class UsageError(Exception):
+    pass
+
+
+def parse_list(text, what, convert):
+    items = [t.strip() for t in text.split(",") if t.strip()]
+    if not items:
+        raise UsageError(f"--{what}: empty list")
+    out = []
+    for t in items:
+        try:
+            out.append(convert(t))
+        except ValueError:
+            raise UsageError(f"--{what}: '{t}' is not valid")
+    if len(set(out)) != len(out):
+        raise UsageError(f"--{what}: '{text}' lists a value twice")
+    return out
+
+
+def point_name(arm, pr, seed):
+    return f"{arm}_pr{pr:g}_s{seed}"
+
+
+def training_seeds(policy_dir):
+    """Seeds a policy trained on (train.json: seed, seed+1, ... one per episode)."""
+    f = pathlib.Path(policy_dir) / "train.json"
+    if not f.exists():
+        return set()
+    t = json.loads(f.read_text())
+    return set(range(int(t["seed"]), int(t["seed"]) + int(t["episodes"])))
+
+
+def state_size(scenario):
+    import yaml
+    f = ROOT / "config" / "scenarios" / scenario / "learning.yaml"
+    return yaml.safe_load(f.read_text())["learning"]["state_size"]
+
+
+def settings_from_args(a):
+    arms = parse_list(a.arms, "arms", str)
+    for arm in arms:
+        if arm not in ALL_ARMS:
+            raise UsageError(f"--arms: unknown arm '{arm}' (one of {', '.join(ALL_ARMS)})")
+    prs = parse_list(a.prs, "prs", float)
+    for pr in prs:
+        if not 0.0 <= pr <= 100.0:
+            raise UsageError(f"--prs: {pr:g} is outside [0, 100]")
+    if a.seeds < 1:
+        raise UsageError(f"--seeds: {a.seeds} must be >= 1")
+    if not a.duration > 0:
+        raise UsageError(f"--duration: {a.duration} must be > 0")
+    if not (ROOT / "config" / "scenarios" / a.scenario / "scenario.yaml").exists():
+        raise UsageError(f"--scenario: no road '{a.scenario}' under config/scenarios")
+    policies = {}
+    for item in a.policy or []:
+        arm, sep, path = item.partition("=")
+        if not sep or arm not in LEARNING_ARMS:
+            raise UsageError(f"--policy: '{item}' is not ARM=DIR with a learning arm")
+        policies[arm] = str(pathlib.Path(path).resolve())
+    seeds = list(range(FIRST_EVAL_SEED, FIRST_EVAL_SEED + a.seeds))
+    for arm in arms:
+        if arm not in LEARNING_ARMS:
+            continue
+        policy = policies.get(arm, str(ROOT / "config" / "policies" / arm))
+        if not (pathlib.Path(policy) / "checkpoints").is_dir() or \
+                not (pathlib.Path(policy) / "train.json").exists():
+            raise UsageError(f"arm '{arm}': no trained policy at {policy} (train it with "
+                             f"./palcas train --arm {arm}, or pass --policy {arm}=DIR)")
+        learnt_on = json.loads((pathlib.Path(policy) / "train.json").read_text())["scenario"]
+        if state_size(learnt_on) != state_size(a.scenario):
+            raise UsageError(f"arm '{arm}': the policy {policy} was trained on road {learnt_on} "
+                             f"(state size {state_size(learnt_on)}), road {a.scenario} has "
+                             f"{state_size(a.scenario)}")
+        seen = training_seeds(policy) & set(seeds)
+        if seen:
+            raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
+                             f"seeds of {policy}")
+        policies[arm] = policy
+    return {"arms": arms, "prs": prs, "seeds": seeds, "duration_s": float(a.duration),
+            "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
+
+
+def merge_settings(out, wanted):
+    """The experiment's settings: new, or the stored ones extended by new arms/PRs/seeds.
+    A changed duration or road is refused (it would mix two experiments in one table)."""
+    f = out / "experiment.json"
+    if not f.exists():
+        return wanted
+    have = json.loads(f.read_text())
+    for key in FIXED_KEYS:
+        if have[key] != wanted[key]:
+            raise UsageError(f"{out} holds an experiment with {key} = {have[key]}, not "
+                             f"{wanted[key]}: use another --out")
+    for arm, policy in wanted["policies"].items():
+        if have["policies"].get(arm, policy) != policy:
+            raise UsageError(f"{out}: arm '{arm}' was run with the policy "
+                             f"{have['policies'][arm]}, not {policy}: use another --out")
+    merged = dict(have)
+    for key in ("arms", "prs", "seeds"):
+        merged[key] = have[key] + [v for v in wanted[key] if v not in have[key]]
+    merged["policies"] = {**have["policies"], **wanted["policies"]}
+    return merged
+
+
+def points_of(settings):
+    """Every (arm, PR, seed) point; the first seed of each (arm, PR) records trajectories
+    for the figures (the others only metrics, to keep the folder small)."""
+    pts = []
+    for pr in settings["prs"]:
+        for seed in settings["seeds"]:
+            for arm in settings["arms"]:
+                pts.append({"name": point_name(arm, pr, seed), "arm": arm, "pr": pr, "seed": seed,
+                            "trajectories": seed == settings["seeds"][0]})
+    return pts
+
+
+def point_command(out, name):
+    return (f"cd {shlex.quote(str(ROOT))} && /usr/bin/python3 tools/experiment.py point "
+            f"--out {shlex.quote(str(out))} --name {shlex.quote(name)}")
+
+
+def point_dir(out, p):
+    return out / "points" / p["name"]
+
+
+def finished(out, p, duration_s):
+    """Its run covered the whole duration and (where the runner recorded it) succeeded."""
+    status = point_dir(out, p) / "point.json"
+    try:
+        if status.exists() and json.loads(status.read_text()).get("status") != "done":
+            return False
+    except ValueError:
+        return False
+    return metrics_complete(out, p, duration_s)
+
+
+def metrics_complete(out, p, duration_s):
+    m = point_dir(out, p) / p["arm"] / "metrics.json"
+    if not m.exists():
+        return False
+    try:
+        d = json.loads(m.read_text())
+    except (OSError, ValueError):
+        return False
+    return float(d.get("sim_seconds", 0.0)) >= duration_s - 1e-6
+
+
+def last_error(console):
+    """The last line of a run's console that names an error, for the failure report."""
+    try:
+        lines = console.read_text(errors="replace").splitlines()
+    except OSError:
+        return "no console.log"
+    for line in reversed(lines):
+        if re.search(r"FATAL|ERROR|error|Assertion|Segmentation|died", line):
+            return re.sub(r"\x1b\[[0-9;]*m", "", line).strip()[:300]
+    return "no error line in console.log"
+
+
+_children = set()
+_children_lock = threading.Lock()
+
+
+def stop_children(grace_s=30.0):
+    """SIGINT to every running point's process group (roslaunch shuts its nodes down), then
+    SIGKILL what is left after grace_s: an interrupted experiment leaves no process behind."""
+    with _children_lock:
+        procs = list(_children)
+    for proc in procs:
+        try:
+            os.killpg(proc.pid, signal.SIGINT)
+        except ProcessLookupError:
+            pass
+    deadline = time.time() + grace_s
+    for proc in procs:
+        try:
+            proc.wait(timeout=max(0.1, deadline - time.time()))
+        except subprocess.TimeoutExpired:
+            try:
+                os.killpg(proc.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
+def run_point(out, name):
+    """Runs one point through ./palcas run and writes its point.json; returns the exit code."""
+    settings = json.loads((out / "experiment.json").read_text())
+    pts = {p["name"]: p for p in points_of(settings)}
+    if name not in pts:
+        raise UsageError(f"{out}: no point '{name}' in this experiment")
+    p = pts[name]
+    d = point_dir(out, p)
+    d.mkdir(parents=True, exist_ok=True)
+    cmd = [str(ROOT / "palcas"), "run", "--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}",
+           "--seed", str(p["seed"]), "--duration", f"{settings['duration_s']:g}",
+           "--scenario", settings["scenario"], "--out", str(d)]
+    if p["arm"] in settings["policies"]:
+        cmd += ["--policy", settings["policies"][p["arm"]]]
+    if not p["trajectories"]:
+        cmd += ["--no-trajectories"]
+    env = dict(os.environ, PALCAS_NO_BUILD="1", PALCAS_SHOW="^$")
+    start = time.time()
+    with open(d / "point.log", "w") as log:
+        # Its own process group, so stop_children() can end roslaunch and every node with it.
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
+                                start_new_session=True)
+        with _children_lock:
+            _children.add(proc)
+        try:
+            code = proc.wait()
+        finally:
+            with _children_lock:
+                _children.discard(proc)
+    wall = time.time() - start
+    ok = code == 0 and metrics_complete(out, p, settings["duration_s"])
+    record = {"name": name, "arm": p["arm"], "pr": p["pr"], "seed": p["seed"],
+              "status": "done" if ok else "failed", "exit_code": code, "wall_s": round(wall, 1),
+              "command": " ".join(shlex.quote(c) for c in cmd), "host": os.uname().nodename}
+    if not ok:
+        record["error"] = last_error(d / p["arm"] / "console.log")
+    tmp = d / "point.json.tmp"
+    tmp.write_text(json.dumps(record, indent=1) + "\n")
+    tmp.replace(d / "point.json")
+    return 0 if ok else 1
+
+
+def write_plan(out, settings):
+    pts = points_of(settings)
+    lines = [point_command(out, p["name"]) for p in pts]
+    (out / "plan.txt").write_text("\n".join(lines) + "\n")
+    slurm = out / "slurm_array.sh"
+    slurm.write_text(
+        "#!/bin/bash\n"
+        "# One array task per experiment point: sbatch slurm_array.sh (from any folder).\n"
+        "# Every task needs this repository built at the same path (./palcas build) and\n"
+        "# SUMO + ROS installed; each starts its own ROS master on a free port.\n"
+        f"#SBATCH --job-name=palcas-experiment\n#SBATCH --array=1-{len(lines)}\n"
+        "#SBATCH --cpus-per-task=2\n#SBATCH --time=00:30:00\n"
+        f"#SBATCH --output={out}/points/slurm-%A_%a.log\n"
+        f"mkdir -p {shlex.quote(str(out))}/points\n"
+        f"eval \"$(sed -n \"${{SLURM_ARRAY_TASK_ID}}p\" {shlex.quote(str(out / 'plan.txt'))})\"\n")
+    slurm.chmod(0o755)
+    return len(lines)
+
+
+def save_settings(out, settings):
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = out / "experiment.json.tmp"
+    tmp.write_text(json.dumps(settings, indent=1) + "\n")
+    tmp.replace(out / "experiment.json")
+
+
+def fmt_time(s):
+    s = int(round(s))
+    return f"{s // 3600}h{s % 3600 // 60:02d}m" if s >= 3600 else f"{s // 60}m{s % 60:02d}s"
+
+
+def run_all(out, settings, jobs):
+    pts = points_of(settings)
+    todo = [p for p in pts if not finished(out, p, settings["duration_s"])]
+    done_before = len(pts) - len(todo)
+    print(f"[experiment] {len(pts)} points ({len(settings['arms'])} arms x "
+          f"{len(settings['prs'])} PRs x {len(settings['seeds'])} seeds, "
+          f"{settings['duration_s']:g} s each); {done_before} finished before, {len(todo)} to run, "
+          f"{jobs} at a time -> {out}", flush=True)
+    lock = threading.Lock()
+    state = {"done": 0, "failed": [], "running": 0, "walls": {}}
+    start = time.time()
+
+    def progress():
+        left = len(todo) - state["done"] - len(state["failed"]) - state["running"]
+        walls = [w for ws in state["walls"].values() for w in ws]
+        per = sum(walls) / len(walls) if walls else None
+        eta = f", ~{fmt_time(per * (left + state['running'] / 2) / jobs)} left" if per else ""
+        kinds = ", ".join(f"{a} {sum(w) / len(w):.0f} s/point" for a, w in state["walls"].items())
+        print(f"[experiment] {done_before + state['done']}/{len(pts)} done, {state['running']} running, "
+              f"{left} left, {len(state['failed'])} failed{eta}; elapsed {fmt_time(time.time() - start)}"
+              + (f" ({kinds})" if kinds else ""), flush=True)
+
+    def work(p):
+        with lock:
+            state["running"] += 1
+        t0 = time.time()
+        code = run_point(out, p["name"])
+        with lock:
+            state["running"] -= 1
+            if code == 0:
+                state["done"] += 1
+                state["walls"].setdefault(p["arm"], []).append(time.time() - t0)
+            else:
+                state["failed"].append(p["name"])
+                err = json.loads((point_dir(out, p) / "point.json").read_text()).get("error", "")
+                print(f"[experiment] FAILED {p['name']}: {err}", flush=True)
+            progress()
+
+    with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = [pool.submit(work, p) for p in todo]
+        try:
+            for f in futures:
+                f.result()
+        except (KeyboardInterrupt, SystemExit):
+            for f in futures:
+                f.cancel()
+            stop_children()
+            raise
+    return state["failed"]
+
+
+def common_options(p):
+    p.add_argument("--out", required=True)
+    p.add_argument("--arms", default="palcas,keep,sumo_native")
+    p.add_argument("--prs", default=",".join(str(x) for x in PAPER_PRS))
+    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--duration", type=float, default=1800.0)
+    p.add_argument("--scenario", default="paper")
+    p.add_argument("--policy", action="append", metavar="ARM=DIR")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    p.add_argument("--check-only", action="store_true",
+                   help="validate the options against DIR and exit (nothing written)")
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise UsageError(message)
+
+
+def main(argv):
+    ap = Parser(prog="experiment.py", description=__doc__,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    common_options(sub.add_parser("run"))
+    common_options(sub.add_parser("plan"))
+    pp = sub.add_parser("point")
+    pp.add_argument("--out", required=True)
+    pp.add_argument("--name", required=True)
+    pc = sub.add_parser("collect")
+    pc.add_argument("--out", required=True)
+    a = ap.parse_args(argv)
+    out = pathlib.Path(a.out).resolve()
+    if a.cmd == "point":
+        if not (out / "experiment.json").exists():
+            raise UsageError(f"{out}: no experiment.json (run 'plan' first)")
+        signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+        try:
+            return run_point(out, a.name)
+        except (KeyboardInterrupt, SystemExit):
+            stop_children()
+            raise
+    if a.cmd == "collect":
+        if not (out / "experiment.json").exists():
+            raise UsageError(f"{out}: no experiment.json, not an experiment folder")
+        settings = json.loads((out / "experiment.json").read_text())
+        return experiment_results.collect(out, settings, points_of(settings))
+    if a.jobs < 1:
+        raise UsageError(f"--jobs: {a.jobs} must be >= 1")
+    settings = merge_settings(out, settings_from_args(a))
+    if a.check_only:
+        return 0
+    save_settings(out, settings)
+    n = write_plan(out, settings)
+    if a.cmd == "plan":
+        print(f"[experiment] {n} point commands in {out / 'plan.txt'}; Slurm: sbatch "
+              f"{out / 'slurm_array.sh'}; afterwards: ./palcas experiment --collect --out {out}")
+        return 0
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # SystemExit: stop_children runs
+    failed = run_all(out, settings, a.jobs)
+    code = experiment_results.collect(out, settings, points_of(settings))
+    if failed:
+        print(f"[experiment] error: {len(failed)} point(s) failed: {', '.join(failed)} "
+              f"(see their point.json; rerun the same command to retry them)", file=sys.stderr)
+        return 1
+    return code
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except UsageError as e:
+        print(f"[experiment] error: {e}", file=sys.stderr)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        print("[experiment] interrupted: finished points are kept; rerun the same command to "
+              "continue", file=sys.stderr)
+        sys.exit(130)
