@@ -186,16 +186,22 @@ def metrics_complete(out, p, duration_s):
     return float(d.get("sim_seconds", 0.0)) >= duration_s - 1e-6
 
 
-def last_error(console):
-    """The last line of a run's console that names an error, for the failure report."""
-    try:
-        lines = console.read_text(errors="replace").splitlines()
-    except OSError:
-        return "no console.log"
-    for line in reversed(lines):
-        if re.search(r"FATAL|ERROR|error|Assertion|Segmentation|died", line):
-            return re.sub(r"\x1b\[[0-9;]*m", "", line).strip()[:300]
-    return "no error line in console.log"
+def last_error(point_log, console):
+    """Why a point failed, for its point.json: the command's own error line, else the last
+    FATAL/ERROR line of the run's console, else the command's last line."""
+    def lines(f):
+        try:
+            return [re.sub(r"\x1b\[[0-9;]*m", "", l).strip() for l in f.read_text(errors="replace").splitlines()]
+        except OSError:
+            return []
+    own = lines(point_log)
+    for line in reversed(own):
+        if "error" in line.lower():
+            return line[:300]
+    for line in reversed(lines(console)):
+        if re.search(r"\[(FATAL|ERROR)\]|Assertion|Segmentation", line):
+            return line[:300]
+    return (own[-1] if own else "no output")[:300]
 
 
 _children = set()
@@ -258,7 +264,7 @@ def run_point(out, name):
               "status": "done" if ok else "failed", "exit_code": code, "wall_s": round(wall, 1),
               "command": " ".join(shlex.quote(c) for c in cmd), "host": os.uname().nodename}
     if not ok:
-        record["error"] = last_error(d / p["arm"] / "console.log")
+        record["error"] = last_error(d / "point.log", d / p["arm"] / "console.log")
     tmp = d / "point.json.tmp"
     tmp.write_text(json.dumps(record, indent=1) + "\n")
     tmp.replace(d / "point.json")
