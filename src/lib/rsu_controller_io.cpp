@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,6 +32,7 @@ struct ControllerCounters {
   uint64_t federation_round = 0;
   uint64_t transitions_stored = 0;
   uint64_t decisions = 0;
+  uint64_t checkpoint_id = 0;  ///< random per write; 0 in files from before it existed
 };
 
 std::string joinPath(const std::string& dir, const char* file) {
@@ -92,6 +94,7 @@ ControllerCounters readCounters(const std::string& path) {
   for (const auto& [key, value] : kv) {
     const std::string where = path + ": key '" + key + "'";
     if (key == "rsu_id") c.rsu_id = value;
+    else if (key == "checkpoint_id") c.checkpoint_id = parseU64(value, where);  // optional
     else if (key == "gradient_credit") c.gradient_credit = parseCredit(value, where);
     else if (numbers.count(key) > 0) *numbers.at(key) = parseU64(value, where);
     else throw std::runtime_error(path + ": unknown key '" + key + "'");
@@ -141,6 +144,21 @@ void RsuController::saveCheckpoint(const std::string& dir) const {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create checkpoint directory " + dir + ": " + ec.message());
+  // Only the owner of the checkpoint on disk may replace it: the process that loaded it or
+  // wrote it last. A stale or orphaned process (an older launch still running) finds
+  // another writer's id there and must not overwrite newer state.
+  const std::string counters_path = joinPath(dir, CONTROLLER_FILE);
+  if (std::filesystem::exists(counters_path)) {
+    const ControllerCounters on_disk = readCounters(counters_path);
+    if (!checkpoint_owned_ || on_disk.checkpoint_id != checkpoint_seen_id_)
+      throw std::runtime_error(
+          dir + " holds a checkpoint this process neither loaded nor wrote (decisions " +
+          std::to_string(on_disk.decisions) + ", this process " + std::to_string(stats_.decisions) +
+          "): another process owns it, so it is not overwritten");
+  }
+  static thread_local std::mt19937_64 ids{std::random_device{}()};
+  uint64_t id = 0;
+  while (id == 0) id = ids();
   agent_.saveCheckpoint(joinPath(dir, AGENT_FILE));  // atomic (temp file + rename)
   std::ostringstream text;
   text.precision(17);  // the credit round-trips exactly
@@ -153,8 +171,11 @@ void RsuController::saveCheckpoint(const std::string& dir) const {
        << "model_version " << model_version_ << "\n"
        << "federation_round " << federation_round_ << "\n"
        << "transitions_stored " << stats_.transitions_stored << "\n"
-       << "decisions " << stats_.decisions << "\n";
-  writeAtomically(joinPath(dir, CONTROLLER_FILE), text.str());
+       << "decisions " << stats_.decisions << "\n"
+       << "checkpoint_id " << id << "\n";
+  writeAtomically(counters_path, text.str());
+  checkpoint_owned_ = true;
+  checkpoint_seen_id_ = id;
 }
 
 void RsuController::loadCheckpoint(const std::string& dir) {
@@ -177,6 +198,8 @@ void RsuController::loadCheckpoint(const std::string& dir) {
   stats_.decisions = c.decisions;
   pending_.clear();  // they belong to the run that wrote the checkpoint
   have_last_step_ = false;
+  checkpoint_owned_ = true;  // this process continues that checkpoint and may replace it
+  checkpoint_seen_id_ = c.checkpoint_id;
 }
 
 }  // namespace palcas::rsu

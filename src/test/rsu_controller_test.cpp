@@ -619,6 +619,38 @@ TEST(RsuController, CheckpointRoundTripRestoresCountersAndWeights) {
   EXPECT_EQ(restored.agent().gradientSteps(), c.agent().gradientSteps());
 }
 
+TEST(RsuController, OnlyTheOwnerOfACheckpointMayReplaceIt) {
+  RsuControllerOptions o = smallOptions();
+  const std::string dir = freshDir("rsu_ckpt_owner");
+  RsuController first(o);
+  first.decide(eightCavs(1), 1, 0.1, GLOBAL, NONE);
+  first.saveCheckpoint(dir);
+  first.saveCheckpoint(dir);  // its own checkpoint: replacing it is fine
+
+  // A newer launch resumes from it and writes on.
+  RsuController resumed(o);
+  resumed.loadCheckpoint(dir);
+  resumed.decide(eightCavs(2), 2, 0.2, GLOBAL, NONE);
+  resumed.decide(eightCavs(3), 3, 0.3, GLOBAL, NONE);
+  resumed.saveCheckpoint(dir);
+  const uint64_t decisions_on_disk = resumed.stats().decisions;
+
+  // The older process, still running (an orphan), must not overwrite the newer state ...
+  first.decide(eightCavs(4), 4, 0.4, GLOBAL, NONE);
+  try {
+    first.saveCheckpoint(dir);
+    FAIL() << "a stale process overwrote a newer checkpoint";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("another process owns it"), std::string::npos) << e.what();
+  }
+  // ... nor may a fresh controller that never loaded it.
+  EXPECT_THROW(RsuController(o).saveCheckpoint(dir), std::runtime_error);
+  RsuController check(o);
+  check.loadCheckpoint(dir);
+  EXPECT_EQ(check.stats().decisions, decisions_on_disk);
+  resumed.saveCheckpoint(dir);  // the owner still can
+}
+
 TEST(RsuController, LoadCheckpointRefusesFilesThatAreNotOursAndStaysUntouched) {
   RsuControllerOptions o = smallOptions();
   RsuController c(o);

@@ -187,7 +187,9 @@ class RsuController {
   /// Writes <dir>/agent.ckpt (PdqnAgent checkpoint: networks, optimisers, replay, epsilon,
   /// RNG) and <dir>/controller.txt (this controller's counters), each atomically (temp
   /// file + rename); creates `dir` if needed. Pending transitions are not saved.
-  /// Throws std::runtime_error on an I/O error.
+  /// Throws std::runtime_error on an I/O error, and (writing nothing) when `dir` already
+  /// holds a checkpoint this controller neither loaded nor wrote last: another process owns
+  /// it, e.g. a newer launch of the same training, and an older one must not overwrite it.
   void saveCheckpoint(const std::string& dir) const;
   /// Reads what saveCheckpoint wrote. Throws std::runtime_error (controller untouched) if
   /// a file is missing, not ours, of another rsu_id or layout, or malformed. On success
@@ -242,6 +244,10 @@ class RsuController {
   uint32_t model_version_ = 0;
   uint32_t federation_round_ = 0;
   RsuControllerStats stats_;
+  // The checkpoint this controller continues (loaded or last wrote): saveCheckpoint only
+  // replaces a file with this id (mutable: saving does not change what the controller does).
+  mutable bool checkpoint_owned_ = false;
+  mutable uint64_t checkpoint_seen_id_ = 0;
 };
 
 }  // namespace palcas::rsu
