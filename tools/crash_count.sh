@@ -31,7 +31,7 @@ for ((k = FIRST; k < FIRST + N; k++)); do
   mkdir -p "$dir"
   port="$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')"
   ROS_MASTER_URI="http://127.0.0.1:$port" ROS_HOSTNAME=127.0.0.1 ROS_LOG_DIR="$dir/ros_log" \
-    timeout -k 10 900 roslaunch -p "$port" palcas_launch palcas.launch mode:=train scenario:="$SCENARIO" \
+    timeout -k 10 900 roslaunch -p "$port" palcas_launch system.launch arm:=palcas mode:=train scenario:="$SCENARIO" \
     clusters:="$clusters" seed:="$k" duration:="$DURATION" out_dir:="$dir" \
     checkpoint_dir:="$dir/checkpoints" bridge_params:="$BRIDGE" >"$dir/console.log" 2>&1
   if [ -f "$dir/metrics.json" ]; then

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Test: a recorded episode bag reproduces the live metrics.
 
-Runs `roslaunch palcas_launch sumo_native.launch scenario:=tiny record:=true` on its own
+Runs `roslaunch palcas_launch system.launch arm:=sumo_native scenario:=tiny record:=true` on its own
 master port, then `metrics_from_bag --compare metrics.json`, which recomputes every metric
 from the bag with the bridge's own measuring code and exits non-zero on any difference.
 """
@@ -28,7 +28,7 @@ class BagMetricsTest(unittest.TestCase):
         port = free_port()
         env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
         launch = subprocess.run(
-            ["roslaunch", "-p", str(port), "palcas_launch", "sumo_native.launch", "scenario:=tiny",
+            ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=sumo_native", "scenario:=tiny",
              "duration:=180", "record:=true", "out_dir:=" + out],
             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=240, text=True)
         self.assertTrue(os.path.exists(out + "/metrics.json"), launch.stdout[-3000:])

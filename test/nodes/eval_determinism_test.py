@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Test: eval mode gives identical advisories for the same seed in two runs.
 
-Runs `roslaunch palcas_launch palcas.launch mode:=eval record:=true` twice on the tiny road
+Runs `roslaunch palcas_launch system.launch arm:=palcas mode:=eval record:=true` twice on the tiny road
 (each on its own master port), reads /advisories from both bags and compares every decision:
 step, RSU, vehicle, action and acceleration.
 """
@@ -28,7 +28,7 @@ def run_eval(out):
     tests = rospkg.RosPack().get_path("palcas_tests")
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
     return subprocess.run(
-        ["roslaunch", "-p", str(port), "palcas_launch", "palcas.launch", "scenario:=tiny", "clusters:=2",
+        ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=palcas", "scenario:=tiny", "clusters:=2",
          "mode:=eval", "duration:=90", "seed:=7", "record:=true", "out_dir:=" + out,
          "learning_params:=%s/launch/small_learning.yaml" % tests,
          "bridge_params:=%s/launch/closed_loop_bridge.yaml" % tests],

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# launch/system.launch runs every arm with the right nodes (roslaunch --nodes, nothing
+# started), refuses an unknown arm naming it, and documents every argument (--ros-args: no
+# "undocumented", no required argument). Needs the workspace built (./palcas test builds).
+#
+#   test/launch/system_launch_test.sh [--xml FILE]
+set -uo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+# shellcheck source=../junit.sh
+source "$ROOT/test/junit.sh"
+XML=""
+[ "${1:-}" != --xml ] || XML="${2:?--xml needs a file}"
+names=() failures=()
+trap 'failed="$(write_junit system_launch "$XML")";
+      echo "system_launch: $((${#names[@]} - failed)) passed, $failed failed"; [ "$failed" -eq 0 ]' EXIT
+export PATH="/usr/bin:$PATH"
+# shellcheck disable=SC1091
+set +u; source "$ROOT/devel/setup.bash"; set -u
+
+expect_nodes() {  # ARM "NODES"
+  local got why=""
+  got="$(roslaunch --nodes palcas_launch system.launch arm:="$1" out_dir:=/tmp/unused 2>&1 | sort | tr '\n' ' ')"
+  [ "$got" = "$2 " ] || why="nodes '$got', expected '$2 '"
+  names+=("arm_$1"); failures+=("$why")
+  if [ -z "$why" ]; then echo "ok   arm_$1"; else echo "FAIL arm_$1: $why"; fi
+}
+expect_nodes palcas "/fedserver/palcas_fedserver /palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
+expect_nodes no_priority "/fedserver/palcas_fedserver /palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
+expect_nodes independent "/palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
+expect_nodes centralized "/central/rsu /palcas_sumo_bridge"
+expect_nodes keep "/palcas_sumo_bridge"
+expect_nodes sumo_native "/palcas_sumo_bridge"
+
+why=""
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=no_priority out_dir:=/tmp/unused 2>&1)"
+grep -q '^/rsu_0/rsu/reward/lambda: 0.0' <<<"$params" || why="no_priority does not set lambda 0"
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep out_dir:=/tmp/unused 2>&1)"
+[ -n "$why" ] || grep -q '^/palcas_sumo_bridge/advisory_control: true' <<<"$params" || why="keep without advisory control"
+names+=(arm_parameters); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameters: $why"; fi
+
+why=""
+out="$(roslaunch --nodes palcas_launch system.launch arm:=bogus out_dir:=/tmp/unused 2>&1)" && why="an unknown arm was accepted"
+[ -n "$why" ] || [[ "$out" == *unknown_arm_bogus* ]] || why="the error does not name the arm: $out"
+names+=(unknown_arm_refused); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   unknown_arm_refused"; else echo "FAIL unknown_arm_refused: $why"; fi
+
+why=""
+doc="$(roslaunch --ros-args palcas_launch system.launch 2>&1)"
+grep -q undocumented <<<"$doc" && why="undocumented arguments: $(grep undocumented <<<"$doc" | tr '\n' ' ')"
+[ -n "$why" ] || ! grep -q 'Required Arguments' <<<"$doc" || why="arguments listed as required: $doc"
+names+=(every_argument_documented); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   every_argument_documented"; else echo "FAIL every_argument_documented: $why"; fi
