@@ -71,3 +71,24 @@ check experiment_pr_out_of_range "--prs: 150 is outside"    experiment --out "$O
 check experiment_seeds_zero    "--seeds: 0 must be >= 1"     experiment --out "$OUT" --arms keep --seeds 0
 check experiment_policy_wrong_road "trained on road paper"  experiment --out "$OUT" --arms palcas --scenario tiny
 check experiment_without_out   "--out"                       experiment --arms keep
+
+# --resume takes road, PR, seed and duration from the training record and refuses a flag
+# that contradicts it (a fake record: these checks stop before anything is built or run).
+RESUME="$WORK/resume_me"
+mkdir -p "$RESUME/checkpoints"
+printf '{"arm": "palcas", "scenario": "tiny", "pr": 40, "seed": 3, "episodes": 4, "duration_s": 300, "learning": "", "rsu_params": "", "bridge_params": "", "paper_printed": false, "explore_fraction": 0.5, "git_commit": "x"}\n' >"$RESUME/train.json"
+check_resume() {  # NAME EXPECTED_TEXT ARGS...: like check, but the record must stay untouched
+  local name="$1" expect="$2"; shift 2
+  local err status=0 why="" before; before="$(cat "$RESUME/train.json")"
+  err="$(cd "$WORK" && timeout -k 5 60 "$ROOT/palcas" train --resume --out "$RESUME" "$@" 2>&1 >/dev/null)" || status=$?
+  if [ "$status" -ne 2 ]; then why="exit status $status, expected 2; stderr: $err"
+  elif [[ "$err" != *"$expect"* ]]; then why="stderr does not contain \"$expect\": $err"
+  elif [ "$(cat "$RESUME/train.json")" != "$before" ]; then why="train.json was rewritten"
+  fi
+  names+=("$name"); failures+=("$why")
+  if [ -z "$why" ]; then echo "ok   $name"; else echo "FAIL $name: $why"; fi
+}
+check_resume resume_other_pr       "trained with --pr 40, not --pr 60"           --pr 60
+check_resume resume_other_duration "trained with --duration 300, not --duration 3600" --duration 3600
+check_resume resume_other_scenario "trained with --scenario tiny, not --scenario paper" --scenario paper
+check_resume resume_other_explore  "leave --explore-fraction out"                --explore-fraction 0.3
