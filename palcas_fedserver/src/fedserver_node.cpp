@@ -46,7 +46,7 @@ void FedServerNode::initializeModel() {
     // A training that stopped before the first round closed has nothing to resume: start
     // from the initial model (the RSUs do the same), and say so.
     if (options_.resume)
-      ROS_WARN("palcas fedserver: resume requested but %s holds no checkpoint; starting afresh",
+      ROS_INFO("palcas fedserver: no checkpoint in %s yet; starting afresh",
                options_.checkpoint_dir.c_str());
     server_.initialize(agent.exportModel());
     return;

@@ -22,9 +22,8 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s) {
   const RsuControllerOptions& c = options_.controller;
   if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
-    // A training that stopped before this RSU wrote anything: start afresh, say so.
-    ROS_WARN("%s: resume requested but %s holds no checkpoint; starting afresh", c.rsu_id.c_str(),
-             checkpointDir().c_str());
+    // A new training, or one that stopped before this RSU wrote anything: start afresh.
+    ROS_INFO("%s: no checkpoint in %s yet; starting afresh", c.rsu_id.c_str(), checkpointDir().c_str());
   } else if (options_.resume) {
     controller_->loadCheckpoint(checkpointDir());
     ROS_INFO("%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
@@ -80,8 +79,8 @@ void RsuNode::loadInitialModel() {
     return;
   }
   // Every RSU starts from the server's model (FedAvg needs a common start); after a resume,
-  // only from a newer one.
-  fetchGlobal(std::max<uint32_t>(1, controller_->modelVersion()));
+  // only from a newer one: the one it already had would undo its local steps since.
+  fetchGlobal(controller_->modelVersion() == 0 ? 1 : controller_->modelVersion() + 1);
 }
 
 void RsuNode::waitForPeers() {
@@ -251,6 +250,9 @@ bool RsuNode::fetchGlobal(uint32_t min_version) {
     fetch_client_ = nh_.serviceClient<palcas_msgs::FetchGlobalModel>(FETCH_MODEL_SERVICE, true);
   federation_reachable_ = fetch_client_.call(srv);
   if (!federation_reachable_) {
+    // A persistent client keeps its broken link after the server died and fails on the
+    // restarted one forever: drop it, the next call connects afresh.
+    fetch_client_.shutdown();
     ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; advising with the local model",
                       options_.controller.rsu_id.c_str());
     return false;
@@ -286,6 +288,7 @@ void RsuNode::federate() {
     submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
   federation_reachable_ = submit_client_.call(srv);
   if (!federation_reachable_) {
+    submit_client_.shutdown();  // as in fetchGlobal: reconnect on the next call
     ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; will submit again later",
                       options_.controller.rsu_id.c_str());
     return;
