@@ -20,6 +20,15 @@ FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh) {
   f.liveness_timeout_s =
       p.number("liveness_timeout", f.liveness_timeout_s, 1e-3, std::numeric_limits<double>::infinity());
   f.max_samples = p.count("max_samples", f.max_samples, 1);
+  f.max_update_norm_ratio = p.number("max_update_norm_ratio", f.max_update_norm_ratio, 0.0, 1e12);
+  const std::string aggregation = p.get<std::string>("aggregation", "fedavg");
+  if (aggregation == "fedavg") f.aggregation = FederationOptions::Aggregation::kFedAvg;
+  else if (aggregation == "median") f.aggregation = FederationOptions::Aggregation::kMedian;
+  else if (aggregation == "trimmed_mean") f.aggregation = FederationOptions::Aggregation::kTrimmedMean;
+  else
+    throw std::invalid_argument("parameter '" + p.fullName("aggregation") + "' is '" + aggregation +
+                                "': one of fedavg, median, trimmed_mean");
+  f.trim_fraction = p.number("trim_fraction", f.trim_fraction, 0.0, 0.4999);
   o.checkpoint_dir = p.get<std::string>("checkpoint_dir", o.checkpoint_dir);
   o.resume = p.get<bool>("resume", o.resume);
   if (o.resume && o.checkpoint_dir.empty())

@@ -29,6 +29,7 @@ const char* rejectionName(Rejection r) {
     case Rejection::kLayoutMismatch: return "layout_mismatch";
     case Rejection::kWrongValueCount: return "wrong_value_count";
     case Rejection::kNonFinite: return "non_finite";
+    case Rejection::kUpdateTooLarge: return "update_too_large";
   }
   return "unknown";
 }
@@ -53,6 +54,11 @@ void FederationOptions::validate() const {
   if (!(liveness_timeout_s > 0))  // also rejects NaN; +inf allowed
     badOption("liveness_timeout_s = " + std::to_string(liveness_timeout_s) + " must be > 0");
   if (max_samples == 0) badOption("max_samples = 0 must be >= 1");
+  if (!(std::isfinite(max_update_norm_ratio) && max_update_norm_ratio >= 0))
+    badOption("max_update_norm_ratio = " + std::to_string(max_update_norm_ratio) +
+              " must be finite and >= 0");
+  if (!(trim_fraction >= 0 && trim_fraction < 0.5))
+    badOption("trim_fraction = " + std::to_string(trim_fraction) + " must be in [0, 0.5)");
 }
 
 FederationServer::FederationServer(FederationOptions options)
@@ -129,6 +135,21 @@ bool FederationServer::checkSubmission(const std::string& rsu_id, uint32_t round
       return refuse(Rejection::kNonFinite, text.str());
     }
   }
+  if (options_.max_update_norm_ratio > 0) {
+    double update2 = 0.0, global2 = 0.0;
+    for (size_t i = 0; i < blob.values.size(); ++i) {
+      const double d = double(blob.values[i]) - double(g.values[i]);
+      update2 += d * d;
+      global2 += double(g.values[i]) * double(g.values[i]);
+    }
+    const double ratio = std::sqrt(update2) / std::max(std::sqrt(global2), 1e-12);
+    if (!(ratio <= options_.max_update_norm_ratio)) {
+      std::ostringstream text;
+      text << "update norm " << std::sqrt(update2) << " is " << ratio
+           << " x the global model's norm, above the bound " << options_.max_update_norm_ratio;
+      return refuse(Rejection::kUpdateTooLarge, text.str());
+    }
+  }
   return true;
 }
 
@@ -196,7 +217,17 @@ void FederationServer::closeRound(double now_s, bool on_deadline) {
   // is finite, so the checks below guard against a broken invariant, not a normal case.
   ModelBlob average;
   try {
-    average = fedAverage(models, counts, options_.max_samples);
+    switch (options_.aggregation) {
+      case FederationOptions::Aggregation::kFedAvg:
+        average = fedAverage(models, counts, options_.max_samples);
+        break;
+      case FederationOptions::Aggregation::kMedian:
+        average = coordinateMedian(models);
+        break;
+      case FederationOptions::Aggregation::kTrimmedMean:
+        average = trimmedMean(models, options_.trim_fraction);
+        break;
+    }
     validateModelBlob(average);
     report.aggregated = true;
   } catch (const std::invalid_argument&) {

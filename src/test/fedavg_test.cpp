@@ -70,6 +70,21 @@ TEST(FedAvg, RejectsBadInputNamingIt) {
   expectRejected({a, b}, {11, 1}, "plausible maximum 10", 10);
 }
 
+TEST(RobustAggregation, MedianAndTrimmedMeanByHand) {
+  const auto m = [](std::vector<float> v) { return ModelBlob{"L", nn::fnv1a64("L"), std::move(v)}; };
+  // Odd count: the middle value per coordinate; even: the mean of the two middle ones.
+  EXPECT_EQ(coordinateMedian({m({1, 9}), m({5, 3}), m({2, 4})}).values, (std::vector<float>{2, 4}));
+  EXPECT_EQ(coordinateMedian({m({1, 9}), m({5, 3}), m({2, 4}), m({8, 0})}).values,
+            (std::vector<float>{3.5f, 3.5f}));
+  // 5 models, trim 0.2: drop the largest and the smallest, average the middle three.
+  const std::vector<ModelBlob> five{m({1}), m({2}), m({3}), m({4}), m({100})};
+  EXPECT_EQ(trimmedMean(five, 0.2).values, (std::vector<float>{3}));
+  EXPECT_EQ(trimmedMean(five, 0.0).values, (std::vector<float>{22}));  // the plain mean
+  EXPECT_THROW(trimmedMean(five, 0.5), std::invalid_argument);
+  EXPECT_THROW(coordinateMedian({m({1, 2}), m({1})}), std::invalid_argument);
+  EXPECT_THROW(coordinateMedian({}), std::invalid_argument);
+}
+
 TEST(FedAvg, AveragesWholeAgentModelsIncludingBatchNormStatistics) {
   PdqnConfig c;
   c.state_size = 4;

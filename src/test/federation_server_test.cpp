@@ -23,6 +23,7 @@ FederationOptions abcOptions() {
   o.expected_rsus = {"a", "b", "c"};
   o.round_deadline_s = 10.0;
   o.liveness_timeout_s = 100.0;
+  o.max_update_norm_ratio = 0.0;  // these tests move the model far; the bound has its own
   return o;
 }
 
@@ -215,6 +216,46 @@ TEST(FederationServer, EveryRejectionLeavesTheGlobalModelUnchanged) {
   EXPECT_EQ(s.globalModel()->values, (std::vector<float>{4, -2, 1}));
 }
 
+TEST(FederationServer, APoisonedUpdateIsRefusedCountedAndLeavesTheModel) {
+  FederationOptions o = abcOptions();
+  o.max_update_norm_ratio = 5.0;  // the default
+  o.max_samples = FEDAVG_MAX_SAMPLES_DEFAULT;
+  FederationServer s = liveAbcServer(o);  // global [1, 2, 3], norm 3.74
+  // The attack: an expected RSU's name, every value 1e30, n_k 1e9.
+  const SubmitResult r = s.submit("a", 1, 1, blob({1e30f, 1e30f, 1e30f}), 1000000000ULL, 1.0);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.rejection, Rejection::kUpdateTooLarge);
+  EXPECT_NE(r.reason.find("above the bound 5"), std::string::npos) << r.reason;
+  EXPECT_EQ(s.status().rejected_by_reason.at("update_too_large"), 1u);
+  // A scaled update just over the bound is refused too; one just under is accepted.
+  EXPECT_FALSE(s.submit("b", 1, 1, blob({1 + 20.0f, 2, 3}), 1, 1.0).accepted);  // 20 / 3.74 = 5.3
+  EXPECT_TRUE(s.submit("b", 1, 1, blob({1 + 18.0f, 2, 3}), 1, 1.0).accepted);   // 4.8
+  EXPECT_TRUE(s.submit("c", 1, 1, blob({1, 2, 3}), 1, 1.0).accepted);
+  EXPECT_TRUE(s.submit("a", 1, 1, blob({1, 2, 3}), 1, 1.0).accepted);  // a may still submit
+  ASSERT_TRUE(s.poll(1.0));
+  EXPECT_EQ(s.globalModel()->values, (std::vector<float>{7, 2, 3}));  // (19 + 1 + 1) / 3
+}
+
+TEST(FederationServer, MedianAndTrimmedMeanKeepOneOutlierOut) {
+  for (auto how : {FederationOptions::Aggregation::kMedian, FederationOptions::Aggregation::kTrimmedMean}) {
+    FederationOptions o = abcOptions();
+    o.aggregation = how;
+    o.trim_fraction = 0.34;  // 3 models: drop 1 at each end = the median
+    FederationServer s = liveAbcServer(o);
+    s.submit("a", 1, 1, blob({1, 2, 3}), 1, 1.0);
+    s.submit("b", 1, 1, blob({2, 3, 4}), 1, 1.0);
+    s.submit("c", 1, 1, blob({1e6f, -1e6f, 1e6f}), 1000000, 1.0);  // n_k cannot buy weight
+    ASSERT_TRUE(s.poll(1.0));
+    EXPECT_EQ(s.globalModel()->values, (std::vector<float>{2, 2, 4}));
+  }
+  FederationOptions bad = abcOptions();
+  bad.trim_fraction = 0.5;
+  expectThrowMentioning<std::invalid_argument>([&] { FederationServer x(bad); }, "trim_fraction");
+  bad = abcOptions();
+  bad.max_update_norm_ratio = -1;
+  expectThrowMentioning<std::invalid_argument>([&] { FederationServer x(bad); }, "max_update_norm_ratio");
+}
+
 TEST(FederationServer, LivenessTimeoutMakesASilentRsuNotNeeded) {
   FederationOptions o = abcOptions();
   o.round_deadline_s = 1000.0;  // far away: only liveness can close the round
@@ -324,7 +365,7 @@ TEST(FederationServer, StatusJsonHoldsRoundVersionAndCounters) {
   EXPECT_EQ(federationStatusJson(s.status()),
             "{\"round\":1,\"version\":1,\"submitted\":[\"b\"],\"rejected_by_reason\":"
             "{\"bad_sample_count\":0,\"duplicate\":1,\"layout_mismatch\":0,\"non_finite\":0,"
-            "\"stale_base_version\":0,\"unknown_rsu\":0,\"wrong_round\":0,"
+            "\"stale_base_version\":0,\"unknown_rsu\":0,\"update_too_large\":0,\"wrong_round\":0,"
             "\"wrong_value_count\":0},\"fetch_unknown_rsu\":0,\"accepted_total\":1,"
             "\"rounds_closed\":0,\"failed_aggregations\":0,\"last_round_s\":0,"
             "\"bytes_in_round\":12,\"bytes_in_last_round\":0}");

@@ -23,4 +23,13 @@ ModelBlob fedAverage(const std::vector<ModelBlob>& models,
                      const std::vector<uint64_t>& sample_counts,
                      uint64_t max_samples = FEDAVG_MAX_SAMPLES_DEFAULT);
 
+/// Coordinate-wise median of `models` (the mean of the two middle values for an even count).
+/// Same checks as fedAverage but no sample counts. Pure; the result is finite.
+ModelBlob coordinateMedian(const std::vector<ModelBlob>& models);
+
+/// Coordinate-wise mean after dropping floor(trim_fraction * K) of the largest and as many
+/// of the smallest values of each coordinate (K = models.size()). trim_fraction in [0, 0.5);
+/// otherwise the same checks as fedAverage. Pure; the result is finite.
+ModelBlob trimmedMean(const std::vector<ModelBlob>& models, double trim_fraction);
+
 }  // namespace palcas

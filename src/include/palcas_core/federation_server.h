@@ -30,6 +30,19 @@ struct FederationOptions {
   /// is not live and not waited for. Must exceed the time an RSU trains between two calls.
   /// > 0 (+inf = an RSU once heard stays live).
   double liveness_timeout_s = 600.0;
+  /// A submission whose update ||theta_k - theta_global|| exceeds this multiple of
+  /// ||theta_global|| is refused (kUpdateTooLarge): one client cannot throw the global model
+  /// anywhere it likes (an all-1e30 model, a scaled update). Measured honest updates of the
+  /// shipped training: 0.20-0.34. >= 0, finite; 0 = no bound.
+  double max_update_norm_ratio = 5.0;
+  /// How a round's models become the global one. kFedAvg: the paper's sample-weighted mean.
+  /// kMedian: coordinate-wise median (n_k ignored; robust while fewer than half the
+  /// submissions are poisoned). kTrimmedMean: per coordinate, the mean after dropping the
+  /// trim_fraction largest and smallest values (n_k ignored).
+  enum class Aggregation { kFedAvg, kMedian, kTrimmedMean };
+  Aggregation aggregation = Aggregation::kFedAvg;
+  /// Share dropped at each end by kTrimmedMean, in [0, 0.5).
+  double trim_fraction = 0.2;
 
   /// ceil(2 n / 3) computed as (2 n + 2) / 3 in integers: 3 -> 2, 4 -> 3, 1 -> 1.
   static size_t defaultQuorum(size_t expected) { return (2 * expected + 2) / 3; }
@@ -49,8 +62,9 @@ enum class Rejection {
   kLayoutMismatch,    ///< layout id or checksum differs from the global model's
   kWrongValueCount,   ///< value count differs from the global model's
   kNonFinite,         ///< a value is NaN or infinite
+  kUpdateTooLarge,    ///< ||theta_k - theta_global|| > max_update_norm_ratio ||theta_global||
 };
-constexpr size_t REJECTION_COUNT = 8;
+constexpr size_t REJECTION_COUNT = 9;
 /// Stable snake_case name of a rejection ("unknown_rsu", ...), used in status JSON.
 const char* rejectionName(Rejection r);
 
