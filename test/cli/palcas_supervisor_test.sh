@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# ./palcas train must not report success when an RSU dies: a tiny training whose RSUs die
+# ./palcas train must not report success when an RSU dies, and SIGTERM of train or run must
+# leave no process behind. First: a tiny training whose RSUs die
 # at start (an out-of-range parameter) exits non-zero with one line naming the node and its
-# error. Needs a built workspace (./palcas test builds first); about a minute.
+# error. Needs a built workspace (./palcas test builds first); about two minutes.
 #
 #   test/cli/palcas_supervisor_test.sh [--xml FILE]
 set -uo pipefail
@@ -27,3 +28,39 @@ elif ! grep -q "run without it" "$WORK/train/aborted_episodes.txt" 2>/dev/null; 
 fi
 names+=(train_fails_when_an_rsu_dies); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   train_fails_when_an_rsu_dies"; else echo "FAIL train_fails_when_an_rsu_dies: $why"; fi
+
+# SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
+# process it started and says so; a training's nodes checkpoint on the way out.
+left_of() {  # DIR: processes whose command line names DIR
+  local p out=""
+  for p in $(pgrep -f "roslaunch|rsu_node|bridge_node|fedserver_node"); do
+    tr '\0' ' ' <"/proc/$p/cmdline" 2>/dev/null | grep -q "$1" && out+="$p "
+  done
+  echo "$out"
+}
+sigterm_case() {  # NAME DIR EXPECTED_EXIT CHECK_CHECKPOINTS COMMAND...
+  local name="$1" dir="$2" expect="$3" ckpt="$4"; shift 4
+  PALCAS_NO_BUILD=1 "$@" >"$WORK/$name.log" 2>&1 &
+  local pid=$! why="" status=0 waited=0
+  # Stop it once its simulation is under way (the bridge announced SUMO), not before.
+  until grep -aq "SUMO 1.15" "$dir"/console.log "$dir"/*/console.log 2>/dev/null || [ $waited -ge 120 ]; do
+    sleep 1; waited=$((waited + 1))
+  done
+  sleep 3
+  kill -TERM "$pid"
+  wait "$pid" || status=$?
+  sleep 1
+  local left; left="$(left_of "$dir")"
+  if [ "$status" -ne "$expect" ]; then why="exit $status, expected $expect: $(tail -2 "$WORK/$name.log")"
+  elif [ -n "$left" ]; then why="processes left behind: $left"; kill -9 $left 2>/dev/null
+  elif ! grep -q "interrupted (TERM)" "$WORK/$name.log"; then why="it did not say it was interrupted"
+  elif [ "$ckpt" = yes ] && [ ! -f "$dir/checkpoints/rsu_0/controller.txt" ]; then why="no checkpoint written on the way out"
+  fi
+  names+=("$name"); failures+=("$why")
+  if [ -z "$why" ]; then echo "ok   $name"; else echo "FAIL $name: $why"; fi
+}
+sigterm_case train_sigterm_leaves_nothing "$WORK/t2" 143 yes \
+  "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 100000 \
+  --learning "$ROOT/config/training/tiny_fast_learning.yaml" --out "$WORK/t2"
+sigterm_case run_sigterm_leaves_nothing "$WORK/r2" 143 no \
+  "$ROOT/palcas" run --arm keep --no-compare --scenario tiny --duration 100000 --out "$WORK/r2"
