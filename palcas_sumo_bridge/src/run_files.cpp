@@ -214,6 +214,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"lane_changes_done", s.lane_changes_done},
               {"lane_changes_dropped", s.lane_changes_dropped},
               {"vanished_vehicles", s.vanished_vehicles},
+              {"route_changes_failed", s.route_changes_failed},
               {"late_rsu_steps", m.late_rsu_steps},
               {"decision_ms_p50", percentile(s.decision_ms, 50)},
               {"decision_ms_p90", percentile(s.decision_ms, 90)},

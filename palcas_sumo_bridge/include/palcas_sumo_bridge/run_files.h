@@ -49,6 +49,7 @@ struct RunSummary {
   /// Advised lane changes finished / dropped for want of a safe gap within their time.
   std::uint64_t lane_changes_done = 0, lane_changes_dropped = 0;
   std::uint64_t vanished_vehicles = 0;  ///< tracked vehicles SUMO no longer knew
+  std::uint64_t route_changes_failed = 0;  ///< exit route changes SUMO refused
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

@@ -373,14 +373,23 @@ void SumoSession::manageExit(VehicleRecord& v) {
     std::fprintf(stderr, "[sumo t=%.1f] %s %s edge=%s lane=%d pos=%.2f\n", time_s_,
                  in_exit_lane ? "commit-exit" : "withdraw-exit", v.id.c_str(), v.edge.c_str(),
                  v.sumo_lane_index, v.lane_pos_m);
-  if (in_exit_lane && !v.exit_committed) {
-    // An explicit two-edge route: SUMO's router (changeTarget) finds no route to the
-    // dead-end ramp edge, but the direct connection from lane 1 exists.
-    api::Vehicle::setRoute(v.id, std::vector<std::string>{v.edge, road_->clusters()[v.exit_cluster].off_ramp_edge});
-    v.exit_committed = true;
-  } else if (!in_exit_lane && v.exit_committed) {
-    api::Vehicle::changeTarget(v.id, end_edge_);
-    v.exit_committed = false;
+  // SUMO can refuse a route change ("No route found", e.g. a vehicle already past the
+  // branch point mid lane change): the vehicle keeps the route it has, the refusal is
+  // counted, and the simulation goes on (it once ended a whole training episode).
+  try {
+    if (in_exit_lane && !v.exit_committed) {
+      // An explicit two-edge route: SUMO's router (changeTarget) finds no route to the
+      // dead-end ramp edge, but the direct connection from lane 1 exists.
+      api::Vehicle::setRoute(v.id, std::vector<std::string>{v.edge, road_->clusters()[v.exit_cluster].off_ramp_edge});
+      v.exit_committed = true;
+    } else if (!in_exit_lane && v.exit_committed) {
+      api::Vehicle::changeTarget(v.id, end_edge_);
+      v.exit_committed = false;
+    }
+  } catch (const libsumo::TraCIException& e) {
+    if (route_changes_failed_++ == 0)
+      std::fprintf(stderr, "palcas sim: t=%.1f s: SUMO refused a route change of '%s' (%s); it keeps "
+                   "its route (counted in route_changes_failed, reported once)\n", time_s_, v.id.c_str(), e.what());
   }
 }
 

@@ -158,6 +158,8 @@ class SumoSession {
   std::uint64_t laneChangesDropped() const { return lane_changes_dropped_; }
   /// Tracked vehicles SUMO no longer knew when a command was applied (forgotten, not fatal).
   std::uint64_t vanishedVehicles() const { return vanished_vehicles_; }
+  /// Exit commitments / withdrawals SUMO refused (the vehicle kept its route).
+  std::uint64_t routeChangesFailed() const { return route_changes_failed_; }
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -192,6 +194,7 @@ class SumoSession {
   StepEvents events_;
   bool open_ = false;
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
+  std::uint64_t route_changes_failed_ = 0;
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
