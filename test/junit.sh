@@ -30,3 +30,31 @@ write_junit() {  # SUITE FILE
   fi
   echo "$failed"
 }
+
+# junit_script SUITE [--xml FILE] (called with the script's "$@"): the common frame of a test
+# script. Sets XML, a fresh WORK folder and empty names/failures; on exit runs
+# $JUNIT_ON_EXIT (e.g. stopping what the script started), writes the JUnit file, prints
+# "SUITE: N passed, N failed", removes WORK (kept and named when a check failed) and exits
+# 0 only if every check passed.
+junit_script() {
+  JUNIT_SUITE="$1"; shift
+  XML=""
+  [ "${1:-}" != --xml ] || XML="${2:?--xml needs a file}"
+  WORK="$(mktemp -d)"
+  names=() failures=()
+  JUNIT_ON_EXIT=""
+  trap junit_finish EXIT
+}
+
+junit_finish() {
+  [ -z "$JUNIT_ON_EXIT" ] || eval "$JUNIT_ON_EXIT"
+  local failed; failed="$(write_junit "$JUNIT_SUITE" "$XML")"
+  if [ "$failed" -eq 0 ]; then rm -rf "$WORK"; else echo "$JUNIT_SUITE: kept $WORK for a look"; fi
+  echo "$JUNIT_SUITE: $((${#names[@]} - failed)) passed, $failed failed"
+  [ "$failed" -eq 0 ] && exit 0 || exit 1
+}
+
+result() {  # NAME WHY: one check ("" = passed), printed as ok / FAIL
+  names+=("$1"); failures+=("$2")
+  if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
+}

@@ -9,12 +9,7 @@ set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 # shellcheck source=../junit.sh
 source "$ROOT/test/junit.sh"
-XML=""
-[ "${1:-}" != --xml ] || XML="${2:?--xml needs a file}"
-WORK="$(mktemp -d)"
-names=() failures=()
-trap 'failed="$(write_junit palcas_supervisor "$XML")"; rm -rf "$WORK";
-      echo "palcas_supervisor: $((${#names[@]} - failed)) passed, $failed failed"; [ "$failed" -eq 0 ]' EXIT
+junit_script palcas_supervisor "$@"
 
 printf 'rsu:\n  gradient_steps_per_decision: -1.0\n' >"$WORK/bad_rsu.yaml"
 status=0
@@ -26,8 +21,7 @@ elif ! grep -q "error: training lost node(s) rsu_0" "$WORK/err.log"; then why="n
 elif ! grep -q "gradient_steps_per_decision" "$WORK/err.log"; then why="the node's error is not named: $(cat "$WORK/err.log")"
 elif ! grep -q "run without it" "$WORK/train/aborted_episodes.txt" 2>/dev/null; then why="aborted_episodes.txt does not record the lost episodes"
 fi
-names+=(train_fails_when_an_rsu_dies); failures+=("$why")
-if [ -z "$why" ]; then echo "ok   train_fails_when_an_rsu_dies"; else echo "FAIL train_fails_when_an_rsu_dies: $why"; fi
+result train_fails_when_an_rsu_dies "$why"
 
 # SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
 # process it started and says so; a training's nodes checkpoint on the way out.
@@ -56,8 +50,7 @@ sigterm_case() {  # NAME DIR EXPECTED_EXIT CHECK_CHECKPOINTS COMMAND...
   elif ! grep -q "interrupted (TERM)" "$WORK/$name.log"; then why="it did not say it was interrupted"
   elif [ "$ckpt" = yes ] && [ ! -f "$dir/checkpoints/rsu_0/controller.txt" ]; then why="no checkpoint written on the way out"
   fi
-  names+=("$name"); failures+=("$why")
-  if [ -z "$why" ]; then echo "ok   $name"; else echo "FAIL $name: $why"; fi
+  result "$name" "$why"
 }
 sigterm_case train_sigterm_leaves_nothing "$WORK/t2" 143 yes \
   "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 100000 \

@@ -13,24 +13,10 @@ set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 # shellcheck source=../junit.sh
 source "$ROOT/test/junit.sh"
-XML=""
-[ "${1:-}" != --xml ] || XML="${2:?--xml needs a file}"
-WORK="$(mktemp -d)"
+junit_script respawn_rejoin "$@"
 OUT="$WORK/train"
-names=() failures=()
 train_pid=""
-cleanup() {
-  [ -z "$train_pid" ] || kill -INT "$train_pid" 2>/dev/null
-  local failed; failed="$(write_junit respawn_rejoin "$XML")"
-  if [ "$failed" -eq 0 ]; then rm -rf "$WORK"; else echo "respawn_rejoin: kept $WORK for a look"; fi
-  echo "respawn_rejoin: $((${#names[@]} - failed)) passed, $failed failed"
-  [ "$failed" -eq 0 ]
-}
-trap cleanup EXIT
-result() {
-  names+=("$1"); failures+=("$2")
-  if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
-}
+JUNIT_ON_EXIT='[ -z "$train_pid" ] || kill -INT "$train_pid" 2>/dev/null'
 pid_of() {  # NODE_BINARY LOG_NAME: the pid of this training's node
   local p
   for p in $(pgrep -f "$1"); do

@@ -8,18 +8,8 @@ set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 # shellcheck source=../junit.sh
 source "$ROOT/test/junit.sh"
-XML=""
-[ "${1:-}" != --xml ] || XML="${2:?--xml needs a file}"
-WORK="$(mktemp -d)"
+junit_script experiment_e2e "$@"
 OUT="$WORK/exp"
-names=() failures=()
-trap 'failed="$(write_junit experiment_e2e "$XML")"; rm -rf "$WORK";
-      echo "experiment_e2e: $((${#names[@]} - failed)) passed, $failed failed"; [ "$failed" -eq 0 ]' EXIT
-
-result() {  # NAME WHY ("" = passed)
-  names+=("$1"); failures+=("$2")
-  if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
-}
 
 exp=(env PALCAS_NO_BUILD=1 "$ROOT/palcas" experiment --arms keep,sumo_native --prs 60 --seeds 2
      --duration 30 --scenario tiny --jobs 2 --out "$OUT")
