@@ -9,14 +9,15 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <palcas_rsu/msg_conversion.h>
+#include <palcas_common/message_auth.h>
+#include <palcas_common/model_weights.h>
 #include "palcas_fedserver/topics.h"
 
 namespace palcas::fedserver {
 
 FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), private_nh_(private_nh), options_(loadFedServerOptions(private_nh_)),
-      server_(options_.federation) {
+      server_(options_.federation), auth_key_(common::loadMessageKey(options_.auth_key_file)) {
   initializeModel();
   status_pub_ = nh_.advertise<std_msgs::String>(FEDERATION_STATUS_TOPIC, 1, true);
   version_pub_ = nh_.advertise<std_msgs::UInt32>(GLOBAL_MODEL_VERSION_TOPIC, 1, true);
@@ -34,6 +35,11 @@ FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            server_.globalModel()->layout_id.c_str(), f.expected_rsus.size(), f.effectiveQuorum(),
            f.round_deadline_s, f.liveness_timeout_s,
            options_.checkpoint_dir.empty() ? "off" : options_.checkpoint_dir.c_str());
+  if (auth_key_)
+    ROS_INFO("palcas fedserver: submissions authenticated with key %s (fingerprint %s)",
+             options_.auth_key_file.c_str(), auth_key_->fingerprint().c_str());
+  else
+    ROS_WARN("palcas fedserver: ~auth_key_file not set: submissions are NOT authenticated");
 }
 
 void FedServerNode::initializeModel() {
@@ -62,8 +68,14 @@ void FedServerNode::initializeModel() {
 bool FedServerNode::onSubmit(palcas_msgs::SubmitWeights::Request& req,
                              palcas_msgs::SubmitWeights::Response& res) {
   const palcas_msgs::ModelWeights& w = req.weights;
-  const SubmitResult r = server_.submit(w.rsu_id, w.round, w.model_version, rsu::toModelBlob(w),
-                                        w.sample_count, nowS());
+  const auth::Verdict verdict = common::verifyMessage(w, auth_key_.get());
+  const SubmitResult r =
+      verdict != auth::Verdict::kAuthentic
+          ? server_.refuse(Rejection::kUnauthenticated,
+                           std::string(auth::verdictName(verdict)) + " on a model naming '" +
+                               w.rsu_id + "'")
+          : server_.submit(w.rsu_id, w.round, w.model_version, common::toModelBlob(w),
+                           w.sample_count, nowS());
   if (r.accepted) {
     ROS_INFO("palcas fedserver: round %u: model from '%s' (n_k %lu)", w.round, w.rsu_id.c_str(),
              static_cast<unsigned long>(w.sample_count));
@@ -87,7 +99,10 @@ bool FedServerNode::onFetch(palcas_msgs::FetchGlobalModel::Request& req,
   res.reason = r.reason;
   // The core keeps the global model finite (validated at start, after every average and
   // on resume), so what is served here is finite.
-  if (r.available) res.weights = rsu::toMsg(*r.model, SERVER_ID, r.round, r.global_version, 0);
+  if (r.available) {
+    res.weights = common::toWeightsMsg(*r.model, SERVER_ID, r.round, r.global_version, 0);
+    common::signMessage(res.weights, auth_key_.get());
+  }
   if (server_.status().fetch_unknown_rsu != unknown_before) {
     ROS_WARN("palcas fedserver: %s", r.reason.c_str());
     publishStatus();

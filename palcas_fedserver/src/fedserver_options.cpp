@@ -1,7 +1,7 @@
 #include "palcas_fedserver/fedserver_options.h"
 
-#include <palcas_msgs/param_reader.h>
-#include <palcas_rsu/core_params.h>
+#include <palcas_common/param_reader.h>
+#include <palcas_common/core_params.h>
 
 #include <limits>
 #include <stdexcept>
@@ -9,7 +9,7 @@
 namespace palcas::fedserver {
 
 FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh) {
-  palcas_msgs::ParamReader p(private_nh);
+  palcas::common::ParamReader p(private_nh);
   FedServerOptions o;
   // The same loader as the RSUs': both build the same network from the same files.
   o.learning = params::loadPdqnConfig(p);
@@ -34,6 +34,8 @@ FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh) {
   if (o.resume && o.checkpoint_dir.empty())
     throw std::invalid_argument("parameter '" + p.fullName("resume") + "' is true but '" +
                                 p.fullName("checkpoint_dir") + "' is empty: nothing to resume from");
+  o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
+  if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
   o.poll_period_s = p.number("poll_period", o.poll_period_s, 1e-3, 3600.0);
   try {
     f.validate();

@@ -1,5 +1,7 @@
 #include "palcas_rsu/rsu_node.h"
 
+#include <palcas_common/message_auth.h>
+#include <palcas_common/model_weights.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/FetchGlobalModel.h>
 #include <palcas_msgs/RegisterRsu.h>
@@ -19,6 +21,7 @@ namespace fs = std::filesystem;
 RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), private_nh_(private_nh), options_(loadRsuNodeOptions(private_nh_)),
       controller_(std::make_unique<RsuController>(options_.controller)),
+      auth_key_(common::loadMessageKey(options_.auth_key_file)),
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s) {
   const RsuControllerOptions& c = options_.controller;
   if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
@@ -166,6 +169,11 @@ void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::
   out.step = msg.step;
   out.rsu_id = options_.controller.rsu_id;
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
+  publishAdvisories(out);
+}
+
+void RsuNode::publishAdvisories(palcas_msgs::AdvisoryArray& out) {
+  common::signMessage(out, auth_key_.get());
   advisories_pub_.publish(out);
 }
 
@@ -197,7 +205,7 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   }
   for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
-  advisories_pub_.publish(out);
+  publishAdvisories(out);
   if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
   if (!options_.learner_thread)
     controller_->learn();  // after publishing: the bridge need not wait for gradient steps
@@ -258,12 +266,19 @@ bool RsuNode::fetchGlobal(uint32_t min_version) {
     return false;
   }
   if (!srv.response.available) return false;
+  const auth::Verdict verdict = common::verifyMessage(srv.response.weights, auth_key_.get());
+  if (verdict != auth::Verdict::kAuthentic) {
+    ROS_ERROR_THROTTLE(10.0, "%s: refused a global model that is not the server's (%s); keeping "
+                       "the local one", options_.controller.rsu_id.c_str(), auth::verdictName(verdict));
+    return false;
+  }
   server_round_ = srv.response.weights.round;  // the round now open
   try {
-    controller_->loadGlobalModel(toModelBlob(srv.response.weights), srv.response.weights.model_version);
+    controller_->loadGlobalModel(common::toModelBlob(srv.response.weights),
+                                 srv.response.weights.model_version);
     submitted_ = false;
-    model_pub_.publish(toMsg(controller_->exportModel(), options_.controller.rsu_id, server_round_,
-                             controller_->modelVersion(), 0));
+    model_pub_.publish(common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
+                                            server_round_, controller_->modelVersion(), 0));
     ROS_INFO("%s: loaded global model version %u (round %u open)", options_.controller.rsu_id.c_str(),
              srv.response.weights.model_version, server_round_);
     return true;
@@ -282,8 +297,10 @@ void RsuNode::federate() {
   }
   if (!controller_->federationDue()) return;
   palcas_msgs::SubmitWeights srv;
-  srv.request.weights = toMsg(controller_->exportModel(), options_.controller.rsu_id, server_round_,
-                              controller_->modelVersion(), controller_->samplesSinceFederation());
+  srv.request.weights = common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
+                                             server_round_, controller_->modelVersion(),
+                                             controller_->samplesSinceFederation());
+  common::signMessage(srv.request.weights, auth_key_.get());
   if (!submit_client_.isValid())
     submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
   federation_reachable_ = submit_client_.call(srv);

@@ -1,15 +1,15 @@
 #include "palcas_rsu/rsu_options.h"
 
-#include <palcas_msgs/param_reader.h>
+#include <palcas_common/param_reader.h>
 
 #include <limits>
 
-#include "palcas_rsu/core_params.h"
+#include "palcas_common/core_params.h"
 
 namespace palcas::rsu {
 
 RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh) {
-  palcas_msgs::ParamReader p(private_nh);
+  palcas::common::ParamReader p(private_nh);
   RsuNodeOptions o;
   RsuControllerOptions& c = o.controller;
   c.rsu_id = p.get<std::string>("rsu/rsu_id", c.rsu_id);
@@ -54,6 +54,8 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh) {
   c.pdqn = params::loadPdqnConfig(p);
   o.policy_dir = p.get<std::string>("policy_dir", o.policy_dir);
   o.checkpoint_dir = p.get<std::string>("checkpoint_dir", o.checkpoint_dir);
+  o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
+  if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
   o.resume = p.get<bool>("resume", o.resume);
   if (o.resume && o.checkpoint_dir.empty())
     throw std::invalid_argument("parameter '" + p.fullName("resume") + "' is true but '" +

@@ -1,5 +1,6 @@
 #include "palcas_sumo_bridge/bridge_node.h"
 
+#include <palcas_common/message_auth.h>
 #include <palcas_core/advisory_validator.h>
 #include <palcas_msgs/AdvisoryRejection.h>
 #include <palcas_msgs/EpisodeMetrics.h>
@@ -40,7 +41,8 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
                                                 options_.lost_after_missed_steps)),
       markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road())),
       rules_(measureRules(options_, session_->road())),
-      measure_(std::make_unique<EpisodeMeasure>(rules_)) {
+      measure_(std::make_unique<EpisodeMeasure>(rules_)),
+      auth_key_(common::loadMessageKey(options_.auth_key_file)) {
   completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(), rules_);
   advertise();
   advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
@@ -49,6 +51,12 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   ROS_INFO("palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
            session_->sumoVersion().c_str(), sim::SumoSession::apiName(), sumocfg_path_.c_str(),
            100.0 * options_.scenario.penetration_rate, options_.scenario.seed, options_.scenario.duration_s, options_.expected_rsus.size());
+  if (auth_key_)
+    ROS_INFO("palcas bridge: advisories authenticated with key %s (fingerprint %s)",
+             options_.auth_key_file.c_str(), auth_key_->fingerprint().c_str());
+  else if (!options_.expected_rsus.empty() || options_.session.advisory_control)
+    ROS_WARN("palcas bridge: ~auth_key_file not set: advisories are NOT authenticated, any "
+             "publisher on %s can steer CAVs", ADVISORIES_TOPIC);
 }
 
 void BridgeNode::advertise() {
@@ -140,7 +148,18 @@ void BridgeNode::publishStep() {
     tf_pub_.publish(markers_->transforms(stamp, session_->vehicles()));
 }
 
-void BridgeNode::onAdvisories(const palcas_msgs::AdvisoryArray::ConstPtr& msg) {
+void BridgeNode::onAdvisories(const ros::MessageEvent<const palcas_msgs::AdvisoryArray>& event) {
+  const palcas_msgs::AdvisoryArray::ConstPtr msg = event.getConstMessage();
+  // Checked before lockstep sees the array: a forged one can neither count as its RSU's
+  // answer nor displace the genuine one.
+  const auth::Verdict verdict = common::verifyMessage(*msg, auth_key_.get());
+  if (verdict != auth::Verdict::kAuthentic) {
+    reject(msg->rsu_id, "", palcas_msgs::AdvisoryRejection::UNAUTHENTICATED,
+           std::string(auth::verdictName(verdict)) + ": array of " +
+               std::to_string(msg->advisories.size()) + " advisories for step " +
+               std::to_string(msg->step) + " published by " + event.getPublisherName());
+    return;
+  }
   if (!lockstep_->enabled()) {
     pending_.push_back(msg);  // free-running: every publisher may advise
     return;

@@ -1,6 +1,6 @@
 #include "palcas_sumo_bridge/bridge_options.h"
 
-#include <palcas_msgs/param_reader.h>
+#include <palcas_common/param_reader.h>
 
 #include <cmath>
 #include <map>
@@ -11,7 +11,7 @@ namespace palcas::bridge {
 namespace {
 
 /// A map of maps of numbers (route shares), e.g. {main: {end: 0.55, off0: 0.15}}.
-std::map<std::string, sim::RouteShares> readShares(palcas_msgs::ParamReader& p, const ros::NodeHandle& nh,
+std::map<std::string, sim::RouteShares> readShares(palcas::common::ParamReader& p, const ros::NodeHandle& nh,
                                                    const std::string& key) {
   std::map<std::string, sim::RouteShares> out;
   std::vector<std::string> names;
@@ -30,7 +30,7 @@ std::map<std::string, sim::RouteShares> readShares(palcas_msgs::ParamReader& p, 
 }
 
 /// ~scenario/*: one key per field of sim::ScenarioConfig, nested maps for the grouped ones.
-sim::ScenarioConfig loadScenario(palcas_msgs::ParamReader& p, const ros::NodeHandle& nh) {
+sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::NodeHandle& nh) {
   sim::ScenarioConfig c;
   p.accept("scenario/scenario_dir");  // the launch's ~scenario_dir wins
   c.cluster_length_m = p.number("scenario/cluster_length_m", c.cluster_length_m, 1.0, 1e5);
@@ -65,7 +65,7 @@ sim::ScenarioConfig loadScenario(palcas_msgs::ParamReader& p, const ros::NodeHan
 }  // namespace
 
 BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
-  palcas_msgs::ParamReader p(private_nh);
+  palcas::common::ParamReader p(private_nh);
   BridgeOptions o;
   o.scenario = loadScenario(p, private_nh);
   o.scenario.scenario_dir = p.get<std::string>("scenario_dir", "");
@@ -98,6 +98,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.integer("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.integer("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
+  o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
+  if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
   o.trajectory_period_steps =
       p.integer("trajectory_period_steps", o.trajectory_period_steps, 0, 1000000);
   o.advisory_hold_steps = p.integer("advisory_hold_steps", o.advisory_hold_steps, 1, 1000000);

@@ -82,6 +82,7 @@ std::string rejectionReasonName(RejectionReason reason) {
     case RejectionReason::kStaleStep: return "stale_step";
     case RejectionReason::kUnknownAction: return "unknown_action";
     case RejectionReason::kDuplicate: return "duplicate";
+    case RejectionReason::kUnauthenticated: return "unauthenticated";
   }
   return "unknown";
 }

@@ -111,14 +111,15 @@ void FederationServer::loadCheckpoint(const std::string& dir) {
                              " was written with (value count or checksum differs)");
   uint64_t rejected[REJECTION_COUNT] = {};
   const json::Value& by_reason = key("rejected_by_reason");
-  // A reason added after the file was written (update_too_large) counts 0; an unknown one
-  // means the file is not ours.
+  // A reason added after the file was written (update_too_large, unauthenticated) counts 0;
+  // an unknown one means the file is not ours.
   size_t known = 0;
   for (size_t i = 0; i < REJECTION_COUNT; ++i) {
     const char* reason = rejectionName(static_cast<Rejection>(i));
     const bool present = std::any_of(by_reason.members.begin(), by_reason.members.end(),
                                      [reason](const auto& m) { return m.first == reason; });
-    const bool optional = static_cast<Rejection>(i) == Rejection::kUpdateTooLarge;
+    const bool optional = static_cast<Rejection>(i) == Rejection::kUpdateTooLarge ||
+                          static_cast<Rejection>(i) == Rejection::kUnauthenticated;
     if (!present && optional) continue;
     rejected[i] = by_reason.at(reason, name("rejected_by_reason")).asUint(name(reason));
     ++known;

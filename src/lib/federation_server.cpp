@@ -30,6 +30,7 @@ const char* rejectionName(Rejection r) {
     case Rejection::kWrongValueCount: return "wrong_value_count";
     case Rejection::kNonFinite: return "non_finite";
     case Rejection::kUpdateTooLarge: return "update_too_large";
+    case Rejection::kUnauthenticated: return "unauthenticated";
   }
   return "unknown";
 }
@@ -168,6 +169,16 @@ SubmitResult FederationServer::submit(const std::string& rsu_id, uint32_t round,
     last_heard_s_[rsu_id] = now_s;
     ++accepted_total_;
   }
+  r.round = round_;
+  r.global_version = version_;
+  return r;
+}
+
+SubmitResult FederationServer::refuse(Rejection why, const std::string& detail) {
+  SubmitResult r;
+  r.rejection = why;
+  r.reason = std::string(rejectionName(why)) + ": " + detail;
+  ++rejected_[static_cast<size_t>(why)];
   r.round = round_;
   r.global_version = version_;
   return r;

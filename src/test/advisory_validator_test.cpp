@@ -157,7 +157,8 @@ TEST(AdvisoryValidator, ReasonCodesMatchAdvisoryRejectionMsg) {
       {"NO_SUCH_LANE", RejectionReason::kNoSuchLane},
       {"STALE_STEP", RejectionReason::kStaleStep},
       {"UNKNOWN_ACTION", RejectionReason::kUnknownAction},
-      {"DUPLICATE", RejectionReason::kDuplicate}};
+      {"DUPLICATE", RejectionReason::kDuplicate},
+      {"UNAUTHENTICATED", RejectionReason::kUnauthenticated}};
   for (const auto& [name, reason] : expected) {
     ASSERT_EQ(msg.count(name), 1u) << name;
     EXPECT_EQ(msg.at(name), static_cast<int>(reason)) << name;

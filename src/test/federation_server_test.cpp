@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <limits>
 
 #include "palcas_core/nn/serialization.h"
@@ -358,6 +359,43 @@ TEST(FederationServer, LoadCheckpointRefusesWhatIsNotOursAndKeepsState) {
   expectRefused(other, "not a PALCAS model file");
 }
 
+TEST(FederationServer, ARefusalFromTheNodeIsCountedAndChangesNothingElse) {
+  FederationServer s = liveAbcServer();
+  const std::string before = federationStatusJson(s.status());
+  const SubmitResult r = s.refuse(Rejection::kUnauthenticated, "forged_tag from 'a'");
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ(r.reason, "unauthenticated: forged_tag from 'a'");
+  EXPECT_EQ(r.round, 1u);
+  EXPECT_EQ(s.status().rejected_by_reason.at("unauthenticated"), 1u);
+  EXPECT_EQ(s.status().accepted_total, 0u);
+  EXPECT_TRUE(s.status().submitted.empty());
+  EXPECT_EQ(s.globalModel()->values, (std::vector<float>{1, 2, 3}));
+  // a may still submit its genuine model in the same round.
+  EXPECT_TRUE(s.submit("a", 1, 1, blob({1, 2, 3}), 1, 1.0).accepted);
+  EXPECT_NE(before, federationStatusJson(s.status()));
+}
+
+TEST(FederationServer, ACheckpointWrittenBeforeTheNewCountersStillLoads) {
+  const std::string dir = tempDir("old_counters");
+  FederationServer s = liveAbcServer();
+  s.refuse(Rejection::kUnauthenticated, "missing_tag");
+  s.saveCheckpoint(dir);
+  const std::string path = dir + "/" + FederationServer::STATE_FILE;
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  std::string state = text.str();
+  for (const std::string key : {"\"unauthenticated\":1,", "\"update_too_large\":0,"}) {
+    const auto at = state.find(key);
+    ASSERT_NE(at, std::string::npos) << key << " not in " << state;
+    state.erase(at, key.size());
+  }
+  std::ofstream(path) << state;
+  FederationServer r(abcOptions());
+  r.loadCheckpoint(dir);
+  EXPECT_EQ(r.status().rejected_by_reason.at("unauthenticated"), 0u);
+  EXPECT_EQ(r.round(), 1u);
+}
+
 TEST(FederationServer, StatusJsonHoldsRoundVersionAndCounters) {
   FederationServer s = liveAbcServer();
   s.submit("b", 1, 1, blob({1, 1, 1}), 1, 1.0);
@@ -365,7 +403,7 @@ TEST(FederationServer, StatusJsonHoldsRoundVersionAndCounters) {
   EXPECT_EQ(federationStatusJson(s.status()),
             "{\"round\":1,\"version\":1,\"submitted\":[\"b\"],\"rejected_by_reason\":"
             "{\"bad_sample_count\":0,\"duplicate\":1,\"layout_mismatch\":0,\"non_finite\":0,"
-            "\"stale_base_version\":0,\"unknown_rsu\":0,\"update_too_large\":0,\"wrong_round\":0,"
+            "\"stale_base_version\":0,\"unauthenticated\":0,\"unknown_rsu\":0,\"update_too_large\":0,\"wrong_round\":0,"
             "\"wrong_value_count\":0},\"fetch_unknown_rsu\":0,\"accepted_total\":1,"
             "\"rounds_closed\":0,\"failed_aggregations\":0,\"last_round_s\":0,"
             "\"bytes_in_round\":12,\"bytes_in_last_round\":0}");

@@ -8,6 +8,9 @@
 #include <ros/ros.h>
 
 #include <palcas_core/federation_server.h>
+#include <palcas_core/message_auth.h>
+
+#include <memory>
 
 #include "palcas_fedserver/fedserver_options.h"
 
@@ -37,6 +40,7 @@ class FedServerNode {
   ros::NodeHandle nh_, private_nh_;
   FedServerOptions options_;
   FederationServer server_;
+  std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: submissions are not authenticated
   ros::Publisher status_pub_, version_pub_;
   ros::ServiceServer submit_srv_, fetch_srv_;
   ros::Timer poll_timer_;

@@ -17,6 +17,9 @@ struct FedServerOptions {
   /// ~learning/*: builds the initial global model (PdqnAgent(learning).exportModel()).
   PdqnConfig learning;
   std::string checkpoint_dir;            ///< "" = no checkpoints
+  /// The deployment's key file (palcas_core/message_auth.h): submissions without its tag are
+  /// refused (counted as unauthenticated), served global models carry it. "" = off.
+  std::string auth_key_file;
   bool resume = false;                   ///< start from checkpoint_dir instead of a fresh model
   double poll_period_s = 0.5;            ///< ROS-time period of the round-closing timer [s]
 };

@@ -5,6 +5,8 @@
 // publishes the advisories, its ClusterState (I2I) and its RsuStatus; in train mode it runs
 // the federation exchange without blocking the advisories.
 
+#include <palcas_core/message_auth.h>
+#include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/VehicleEventArray.h>
 #include <palcas_msgs/VehicleStateArray.h>
@@ -42,6 +44,8 @@ class RsuNode {
   void federate();
   bool fetchGlobal(uint32_t min_version);
   void checkpoint();
+  /// Signs (with a key) and publishes one step's answer.
+  void publishAdvisories(palcas_msgs::AdvisoryArray& out);
   /// Appends this episode's learning row to <checkpoint_dir>/<rsu_id>/learning.csv.
   void endEpisodeLog();
   std::string checkpointDir() const;
@@ -49,6 +53,7 @@ class RsuNode {
   ros::NodeHandle nh_, private_nh_;
   RsuNodeOptions options_;
   std::unique_ptr<RsuController> controller_;
+  std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: nothing signed or checked
   // The running learn() of the last decision (learner_thread); joinLearner() before any
   // other use of controller_.
   std::future<void> learner_;

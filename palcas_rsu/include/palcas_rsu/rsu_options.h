@@ -23,6 +23,9 @@ struct RsuNodeOptions {
   bool learner_thread = false;
   std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
   std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
+  /// The deployment's key file (palcas_core/message_auth.h): advisories and submissions are
+  /// signed with it, a global model without its tag is refused. "" = authentication off.
+  std::string auth_key_file;
   bool resume = false;               ///< continue from the checkpoint in checkpoint_dir
   int checkpoint_every_decisions = 0;  ///< 0 = only at shutdown
   bool federation = true;            ///< false: no federation server (baselines)

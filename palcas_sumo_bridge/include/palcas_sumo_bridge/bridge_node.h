@@ -4,6 +4,7 @@
 // loop iteration: publish the state of step k, wait (lockstep) for the RSUs' advisories
 // for step k, apply them, advance SUMO to step k+1, measure.
 
+#include <palcas_core/message_auth.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/RegisterRsu.h>
 #include <palcas_msgs/VehicleStateArray.h>
@@ -50,7 +51,7 @@ class BridgeNode {
   void applyAdvisories();
   void advance();
   void publishMetrics();
-  void onAdvisories(const palcas_msgs::AdvisoryArray::ConstPtr& msg);
+  void onAdvisories(const ros::MessageEvent<const palcas_msgs::AdvisoryArray>& event);
   bool onRegister(palcas_msgs::RegisterRsu::Request& req, palcas_msgs::RegisterRsu::Response& res);
   void reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
               const std::string& detail);
@@ -65,6 +66,7 @@ class BridgeNode {
   MeasureRules rules_;
   std::unique_ptr<EpisodeMeasure> measure_;
   std::unique_ptr<sim::RunRecorder> recorder_;  ///< trajectories.csv + decisions.csv, if asked
+  std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: advisories are not authenticated
   int episode_ = 0;
 
   ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,

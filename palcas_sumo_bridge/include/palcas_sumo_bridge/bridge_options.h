@@ -33,6 +33,9 @@ struct BridgeOptions {
   int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
   int lost_after_missed_steps = 50;        ///< consecutive misses before an RSU is lost
   int max_advisory_age_steps = 0;          ///< 0 = an advisory must answer the current step
+  /// Key file of the deployment (palcas_core/message_auth.h): advisory arrays without its
+  /// tag are refused. "" = authentication off (any publisher may advise; warned at start).
+  std::string auth_key_file;
   /// An applied advisory holds this many steps; then, without a new one, the CAV keeps its
   /// speed. CAVs of an RSU that misses a step's deadline keep their speed at once.
   int advisory_hold_steps = 10;

@@ -19,10 +19,13 @@ enum class RejectionReason : int {
   kStaleStep = 5,         ///< answers an older step than allowed (or a future one)
   kUnknownAction = 6,     ///< action code outside 0..3
   kDuplicate = 7,         ///< the vehicle already received an advisory this step
+  /// The whole array's authentication tag is missing or wrong (palcas_core/message_auth.h):
+  /// counted once per array, before any of its advisories is looked at.
+  kUnauthenticated = 8,
 };
-constexpr int REJECTION_REASON_COUNT = 8;
+constexpr int REJECTION_REASON_COUNT = 9;
 
-/// Name used in logs and JSON ("unknown_vehicle", ..., "duplicate"); "unknown" otherwise.
+/// Name used in logs and JSON ("unknown_vehicle", ..., "unauthenticated"); "unknown" otherwise.
 std::string rejectionReasonName(RejectionReason reason);
 
 /// One advisory as received (mirrors palcas_msgs/Advisory plus its AdvisoryArray's step/rsu).

@@ -63,8 +63,9 @@ enum class Rejection {
   kWrongValueCount,   ///< value count differs from the global model's
   kNonFinite,         ///< a value is NaN or infinite
   kUpdateTooLarge,    ///< ||theta_k - theta_global|| > max_update_norm_ratio ||theta_global||
+  kUnauthenticated,   ///< the message's authentication tag is missing or wrong (node-checked)
 };
-constexpr size_t REJECTION_COUNT = 9;
+constexpr size_t REJECTION_COUNT = 10;
 /// Stable snake_case name of a rejection ("unknown_rsu", ...), used in status JSON.
 const char* rejectionName(Rejection r);
 
@@ -127,6 +128,10 @@ class FederationServer {
   /// before initialize/loadCheckpoint, std::invalid_argument if now_s is not finite.
   SubmitResult submit(const std::string& rsu_id, uint32_t round, uint32_t base_version,
                       ModelBlob blob, uint64_t n_k, double now_s);
+  /// A submission refused before submit() could look at it (the node found its
+  /// authentication tag missing or wrong): counted under `why` like submit's refusals,
+  /// nothing else changes. The reason reads "<rejectionName>: <detail>".
+  SubmitResult refuse(Rejection why, const std::string& detail);
 
   /// Closes the open round if every live expected RSU submitted, or if round_deadline_s
   /// passed since its first accepted submission and at least `quorum` submitted. Closing:

@@ -9,7 +9,7 @@
 #include <palcas_core/pdqn_config.h>
 #include <palcas_core/reward.h>
 #include <palcas_core/state_builder.h>
-#include <palcas_msgs/param_reader.h>
+#include <palcas_common/param_reader.h>
 
 #include <limits>
 #include <string>
@@ -17,7 +17,7 @@
 namespace palcas::params {
 
 /// ~<ns>/<name> for every name of rewardParamNames(); validated as a whole.
-inline RewardParams loadRewardParams(palcas_msgs::ParamReader& p, const std::string& ns = "reward") {
+inline RewardParams loadRewardParams(palcas::common::ParamReader& p, const std::string& ns = "reward") {
   RewardParams r;
   for (const std::string& name : rewardParamNames()) {
     const std::string key = ns + "/" + name;
@@ -32,7 +32,7 @@ inline RewardParams loadRewardParams(palcas_msgs::ParamReader& p, const std::str
 }
 
 /// ~<ns>/* = config/learning.yaml's keys, one per PdqnConfig field.
-inline PdqnConfig loadPdqnConfig(palcas_msgs::ParamReader& p, const std::string& ns = "learning") {
+inline PdqnConfig loadPdqnConfig(palcas::common::ParamReader& p, const std::string& ns = "learning") {
   constexpr int BIG = std::numeric_limits<int>::max();
   const std::string k = ns + "/";
   PdqnConfig c;
@@ -73,7 +73,7 @@ inline PdqnConfig loadPdqnConfig(palcas_msgs::ParamReader& p, const std::string&
 }
 
 /// ~<ns>/* = the state_scales map of config/rsu.yaml.
-inline StateScales loadStateScales(palcas_msgs::ParamReader& p, const std::string& ns = "state_scales") {
+inline StateScales loadStateScales(palcas::common::ParamReader& p, const std::string& ns = "state_scales") {
   StateScales s;
   const std::string k = ns + "/";
   s.road_length_m = p.number(k + "road_length_m", s.road_length_m, 1e-3, 1e9);

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-namespace palcas_msgs {
+namespace palcas::common {
 
 class ParamReader {
  public:
@@ -96,4 +96,4 @@ class ParamReader {
   std::set<std::string> known_;
 };
 
-}  // namespace palcas_msgs
+}  // namespace palcas::common

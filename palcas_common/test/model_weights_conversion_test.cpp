@@ -1,5 +1,5 @@
 // ModelBlob <-> palcas_msgs/ModelWeights: a round trip keeps every field bit for bit.
-#include "palcas_rsu/msg_conversion.h"
+#include "palcas_common/model_weights.h"
 
 #include <gtest/gtest.h>
 
@@ -7,13 +7,13 @@
 #include <limits>
 
 using palcas::ModelBlob;
-using palcas::rsu::toModelBlob;
-using palcas::rsu::toMsg;
+using palcas::common::toModelBlob;
+using palcas::common::toWeightsMsg;
 
-TEST(FedServerMsgConversion, ModelRoundTripKeepsEveryField) {
+TEST(ModelWeightsConversion, ModelRoundTripKeepsEveryField) {
   const ModelBlob blob{"pdqn v1 mu[45-8-4] q[49-8-4]", 0xFEDCBA9876543210ULL,
                        {0.0f, -1.5f, 3.4e38f, 1e-45f, -0.0f}};
-  const palcas_msgs::ModelWeights msg = toMsg(blob, "server", 7, 6, 123456789012ULL);
+  const palcas_msgs::ModelWeights msg = toWeightsMsg(blob, "server", 7, 6, 123456789012ULL);
   EXPECT_EQ(msg.rsu_id, "server");
   EXPECT_EQ(msg.round, 7u);
   EXPECT_EQ(msg.model_version, 6u);
@@ -27,7 +27,7 @@ TEST(FedServerMsgConversion, ModelRoundTripKeepsEveryField) {
   EXPECT_TRUE(std::signbit(back.values[4]));  // -0.0 stays negative zero
 }
 
-TEST(FedServerMsgConversion, NonFiniteValuesPassThroughForTheServerToRefuse) {
+TEST(ModelWeightsConversion, NonFiniteValuesPassThroughForTheServerToRefuse) {
   // Conversion does not judge: the FederationServer names the bad index in its reason.
   palcas_msgs::ModelWeights msg;
   msg.values = {1.0f, std::numeric_limits<float>::quiet_NaN()};
