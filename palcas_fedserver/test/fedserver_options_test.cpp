@@ -39,7 +39,9 @@ TEST(FedServerOptions, ShippedFilesLoad) {
   EXPECT_EQ(o.federation.expected_rsus, (std::vector<std::string>{"rsu_0", "rsu_1", "rsu_2"}));
   EXPECT_EQ(o.federation.effectiveQuorum(), 2u);  // quorum 0 -> ceil(2/3 * 3) = 2
   EXPECT_DOUBLE_EQ(o.federation.round_deadline_s, 30.0);
-  EXPECT_DOUBLE_EQ(o.federation.liveness_timeout_s, 600.0);
+  EXPECT_DOUBLE_EQ(o.federation.liveness_timeout_s, 60.0);  // RSUs send heartbeats every 10 s
+  // One source for the default: the YAML and the struct agree.
+  EXPECT_DOUBLE_EQ(o.federation.liveness_timeout_s, palcas::FederationOptions{}.liveness_timeout_s);
   EXPECT_EQ(o.federation.max_samples, 1000000000u);  // fedserver.yaml
   EXPECT_EQ(o.learning.hidden_sizes, (std::vector<int>{256, 512, 256}));  // paper
   EXPECT_EQ(o.learning.state_size, 45);                                    // paper

@@ -219,7 +219,7 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   episode_log_.transitions += closed.transitions_closed;
   episode_log_.reward_sum += closed.sum_reward;
   episode_log_.decision_ms_sum += out.decision_ms;
-  if (c.train && options_.federation) federate();
+  if (c.train && options_.federation) federate(now_s);
   if (c.train && options_.checkpoint_every_decisions > 0 && !options_.checkpoint_dir.empty() &&
       decisions_ % static_cast<std::uint64_t>(options_.checkpoint_every_decisions) == 0)
     checkpoint();
@@ -289,13 +289,25 @@ bool RsuNode::fetchGlobal(uint32_t min_version) {
   }
 }
 
-void RsuNode::federate() {
+void RsuNode::federate(double now_s) {
+  // The sim clock restarts with every episode: a call "in the future" is from the last one.
+  if (last_server_call_s_ > now_s) last_server_call_s_ = now_s;
   // Waiting for the round to close: poll without blocking the advisories.
   if (submitted_) {
+    last_server_call_s_ = now_s;
     fetchGlobal(controller_->modelVersion() + 1);
     return;
   }
-  if (!controller_->federationDue()) return;
+  if (!controller_->federationDue()) {
+    // Training between rounds: a heartbeat keeps this RSU live at the server (and picks up
+    // a global model that moved on without it).
+    if (options_.federation_heartbeat_s > 0 && now_s - last_server_call_s_ >= options_.federation_heartbeat_s) {
+      last_server_call_s_ = now_s;
+      fetchGlobal(controller_->modelVersion() + 1);
+    }
+    return;
+  }
+  last_server_call_s_ = now_s;
   palcas_msgs::SubmitWeights srv;
   srv.request.weights = common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
                                              server_round_, controller_->modelVersion(),

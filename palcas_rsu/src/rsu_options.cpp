@@ -65,6 +65,7 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh) {
   o.federation = p.get<bool>("federation", o.federation);
   if (!o.federation) c.federation_interval_steps = 0;  // never due
   o.federation_wait_s = p.number("federation_wait", o.federation_wait_s, 0.0, 3600.0);
+  o.federation_heartbeat_s = p.number("federation_heartbeat", o.federation_heartbeat_s, 0.0, 1e6);
   o.i2i = p.get<bool>("i2i", o.i2i);
   o.i2i_stale_after_s = p.number("i2i_stale_after", o.i2i_stale_after_s, 1e-3, 1e9);
   o.register_timeout_s = p.number("register_timeout", o.register_timeout_s, 0.0, 3600.0);

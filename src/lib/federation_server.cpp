@@ -198,6 +198,9 @@ bool FederationServer::allLiveSubmitted(double now_s) const {
 bool FederationServer::poll(double now_s) {
   requireReady(now_s, "poll");
   if (submissions_.empty()) return false;  // a round never closes empty
+  // Sim time restarts with each episode: count the deadline from the restart instead of
+  // waiting for the new episode's clock to pass the old one's.
+  if (now_s < first_submit_s_) first_submit_s_ = now_s;
   if (allLiveSubmitted(now_s)) {
     closeRound(now_s, false);
     return true;

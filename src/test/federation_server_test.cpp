@@ -271,6 +271,20 @@ TEST(FederationServer, LivenessTimeoutMakesASilentRsuNotNeeded) {
   EXPECT_EQ(s.globalModel()->values, (std::vector<float>{7.0f, 1.0f, 0.25f}));  // as above
 }
 
+TEST(FederationServer, ADeadlineSurvivesTheClockRestartingWithAnEpisode) {
+  FederationServer s = liveAbcServer();  // deadline 10 s; a, b, c heard at t = 0
+  s.fetch("c", 2, 1195.0);
+  ASSERT_TRUE(s.submit("a", 1, 1, blob({4, -2, 1}), 1, 1195.0).accepted);
+  ASSERT_TRUE(s.submit("b", 1, 1, blob({8, 2, 0}), 3, 1195.0).accepted);
+  EXPECT_FALSE(s.poll(1199.0));  // c still live, the deadline not reached
+  // The next episode starts at sim time 0: the deadline counts from the restart, it does
+  // not wait for the new clock to pass 1205 s.
+  EXPECT_FALSE(s.poll(0.0));
+  EXPECT_FALSE(s.poll(9.0));
+  ASSERT_TRUE(s.poll(10.0));
+  EXPECT_TRUE(s.lastRound().on_deadline);
+}
+
 TEST(FederationServer, AnRsuNeverHeardFromIsNotWaitedFor) {
   FederationServer s(abcOptions());
   s.initialize(blob({1, 2, 3}));

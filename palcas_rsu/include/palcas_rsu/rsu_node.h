@@ -41,7 +41,8 @@ class RsuNode {
   void waitForPeers();
   void registerWithBridge();
   void loadInitialModel();
-  void federate();
+  /// now_s: the decision's sim time (heartbeats are paced by it).
+  void federate(double now_s);
   bool fetchGlobal(uint32_t min_version);
   void checkpoint();
   /// Signs (with a key) and publishes one step's answer.
@@ -83,6 +84,7 @@ class RsuNode {
   uint32_t server_round_ = 0;
   bool submitted_ = false;
   bool federation_reachable_ = false;
+  double last_server_call_s_ = -1e300;  ///< sim time of the last call to the server
 };
 
 }  // namespace palcas::rsu

@@ -30,6 +30,9 @@ struct RsuNodeOptions {
   int checkpoint_every_decisions = 0;  ///< 0 = only at shutdown
   bool federation = true;            ///< false: no federation server (baselines)
   double federation_wait_s = 30.0;   ///< wall time to wait for the server at start [s]
+  /// Sim time between heartbeat fetches while training between rounds [s], so the server
+  /// can tell a busy RSU from a dead one with a short liveness timeout. 0 = none.
+  double federation_heartbeat_s = 10.0;
   bool i2i = true;                   ///< false: no cluster-state exchange (global part unknown)
   double i2i_stale_after_s = 5.0;    ///< sim time after which a peer's state is stale [s]
   double register_timeout_s = 60.0;  ///< wall time to wait for the bridge's register service [s]

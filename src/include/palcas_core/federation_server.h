@@ -27,9 +27,9 @@ struct FederationOptions {
   /// n_k above this is implausible (a bug in the sender) and rejected. >= 1.
   uint64_t max_samples = FEDAVG_MAX_SAMPLES_DEFAULT;
   /// An expected RSU not heard from (accepted submit or fetch) for this long, or never,
-  /// is not live and not waited for. Must exceed the time an RSU trains between two calls.
-  /// > 0 (+inf = an RSU once heard stays live).
-  double liveness_timeout_s = 600.0;
+  /// is not live and not waited for. Must exceed the time between two calls of a live RSU
+  /// (RSU heartbeats: every 10 s by default). > 0 (+inf = an RSU once heard stays live).
+  double liveness_timeout_s = 60.0;
   /// A submission whose update ||theta_k - theta_global|| exceeds this multiple of
   /// ||theta_global|| is refused (kUpdateTooLarge): one client cannot throw the global model
   /// anywhere it likes (an all-1e30 model, a scaled update). Measured honest updates of the
@@ -134,7 +134,8 @@ class FederationServer {
   SubmitResult refuse(Rejection why, const std::string& detail);
 
   /// Closes the open round if every live expected RSU submitted, or if round_deadline_s
-  /// passed since its first accepted submission and at least `quorum` submitted. Closing:
+  /// passed since its first accepted submission and at least `quorum` submitted. A clock
+  /// that went back (sim time restarts with every episode) restarts the deadline from now_s. Closing:
   /// sample-weighted fedAverage of the submitted models; a finite result becomes the
   /// global model and version += 1; a non-finite one is dropped (old global kept, counted).
   /// Either way round += 1 and submissions are cleared. Never waits.
