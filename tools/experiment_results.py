@@ -190,3 +190,49 @@ def collect(out, settings, points):
     print(f"[experiment] {done}/{len(rows)} points in the tables: {out / 'tables.md'}, "
           f"{out / 'results.csv'}; {len(pngs)} figures in {out / 'figures'}")
     return 0 if done == len(rows) else 1
+
+
+def merge(out, csv_paths, seeds, duration_s, scenario):
+    """Tables from the results.csv of several experiments on the same road, seeds and
+    duration (e.g. arms run in different sessions): rows are taken as they are, a point
+    present twice is an error. Figures stay with each experiment (they need its runs)."""
+    out = pathlib.Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows, seen, arms, prs = [], set(), [], []
+    for path in csv_paths:
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                if r["point"] in seen:
+                    raise ValueError(f"{path}: point {r['point']} is already in another results.csv")
+                seen.add(r["point"])
+                r["pr"] = float(r["pr"])
+                if int(r["seed"]) not in seeds:
+                    raise ValueError(f"{path}: point {r['point']} has seed {r['seed']}, not one of {seeds}")
+                rows.append(r)
+                if r["arm"] not in arms:
+                    arms.append(r["arm"])
+                if r["pr"] not in prs:
+                    prs.append(r["pr"])
+    settings = {"arms": arms, "prs": sorted(prs), "seeds": seeds, "duration_s": duration_s,
+                "scenario": scenario}
+    write_results_csv(out, rows)
+    write_tables(out, settings, rows, aggregate(rows, arms, settings["prs"]), read_paper())
+    return rows
+
+
+if __name__ == "__main__":
+    import argparse
+    parser = argparse.ArgumentParser(description="merge the results.csv of experiments run "
+                                     "apart (same road, seeds, duration) into one set of tables")
+    parser.add_argument("command", choices=["merge"])
+    parser.add_argument("--out", required=True)
+    parser.add_argument("--seeds", default="101,102,103")
+    parser.add_argument("--duration", type=float, default=1800.0)
+    parser.add_argument("--scenario", default="paper")
+    parser.add_argument("results", nargs="+")
+    a = parser.parse_args()
+    try:
+        merged = merge(a.out, a.results, [int(s) for s in a.seeds.split(",")], a.duration, a.scenario)
+    except (OSError, ValueError, KeyError) as e:
+        sys.exit(f"experiment_results merge: {e}")
+    print(f"[experiment] {len(merged)} points merged: {pathlib.Path(a.out) / 'tables.md'}")

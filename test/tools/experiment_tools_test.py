@@ -149,6 +149,30 @@ class CollectorTest(unittest.TestCase):
         self.assertIn("keep_pr60_s103 (incomplete)", md)
         self.assertIn("keep_pr60_s104 (failed)", md)
 
+    def test_experiments_run_apart_merge_into_one_table(self):
+        experiment_results.collect(self.out, self.s, self.pts)
+        # A second experiment with another arm, as if run in another session.
+        other = self.out / "other"
+        other.mkdir()
+        with open(other / "results.csv", "w", newline="") as f:
+            rows = read_csv(self.out / "results.csv")
+            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+            w.writeheader()
+            for r in rows:
+                w.writerow(dict(r, point=r["point"].replace("keep", "independent"),
+                                arm="independent"))
+        merged = self.out / "merged"
+        experiment_results.merge(merged, [self.out / "results.csv", other / "results.csv"],
+                                 [101, 102, 103, 104], 1800.0, "tiny")
+        dsr = read_csv(merged / "table_dsr_pct.csv")
+        self.assertEqual([r["arm"] for r in dsr], ["keep", "independent"])
+        self.assertEqual(dsr[0]["mean"], dsr[1]["mean"])
+        self.assertEqual(dsr[1]["n"], "2")  # only finished points count, as in collect
+        self.assertIn("Baseline-2 (independent)", (merged / "tables.md").read_text())
+        with self.assertRaisesRegex(ValueError, "already in another results.csv"):
+            experiment_results.merge(merged, [other / "results.csv", other / "results.csv"],
+                                     [101, 102, 103, 104], 1800.0, "tiny")
+
     def test_paper_numbers_sit_beside_ours(self):
         paper = experiment_results.read_paper()
         self.assertEqual(paper[("palcas", 60.0, "dsr_pct")], (93.97, 3.56))
