@@ -164,7 +164,11 @@ void BridgeNode::onAdvisories(const ros::MessageEvent<const palcas_msgs::Advisor
     pending_.push_back(msg);  // free-running: every publisher may advise
     return;
   }
-  switch (lockstep_->onAnswer(msg->rsu_id, msg->step)) {
+  const sim::Lockstep::Answer answer = lockstep_->onAnswer(msg->rsu_id, msg->step);
+  for (const std::string& id : lockstep_->takeRevived())
+    ROS_WARN("palcas bridge: RSU '%s' answers again (step %lu): waited for from the next step "
+             "on", id.c_str(), static_cast<unsigned long>(msg->step));
+  switch (answer) {
     case sim::Lockstep::Answer::kAccepted:
       pending_.push_back(msg);
       break;

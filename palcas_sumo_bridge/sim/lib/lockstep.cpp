@@ -53,12 +53,18 @@ Lockstep::Answer Lockstep::onAnswer(const std::string& rsu_id, std::uint64_t ste
   RsuStatus& s = it->second;
   if (!step_open_ || step != open_step_) {
     ++s.late_answers;
+    if (s.lost && step <= open_step_ && open_step_ - step <= REVIVE_WINDOW_STEPS) {
+      s.lost = false;  // waited for again from the next step on
+      s.consecutive_misses = 0;
+      revived_.push_back(rsu_id);
+    }
     return Answer::kStale;
   }
   if (s.answered) return Answer::kDuplicate;
   s.answered = true;
   // An answer proves the RSU is there, even if it never registered or was lost.
   s.registered = true;
+  if (s.lost) revived_.push_back(rsu_id);
   s.lost = false;
   s.consecutive_misses = 0;
   return Answer::kAccepted;
@@ -90,6 +96,12 @@ std::vector<std::string> Lockstep::endStep(std::vector<std::string>* newly_lost)
   if (!late.empty()) ++late_steps_;
   step_open_ = false;
   return late;
+}
+
+std::vector<std::string> Lockstep::takeRevived() {
+  std::vector<std::string> out;
+  out.swap(revived_);
+  return out;
 }
 
 bool Lockstep::isLive(const std::string& rsu_id) const {

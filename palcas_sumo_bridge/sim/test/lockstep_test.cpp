@@ -69,6 +69,30 @@ TEST(Lockstep, LateRsuIsCountedThenLostThenRevived) {
   EXPECT_EQ(ls.onAnswer("rsu_1", 3), Lockstep::Answer::kAccepted);
   EXPECT_TRUE(ls.isLive("rsu_1"));
   EXPECT_FALSE(ls.complete());  // now rsu_0 is waited for
+  EXPECT_EQ(ls.takeRevived(), std::vector<std::string>{"rsu_1"});
+  EXPECT_TRUE(ls.takeRevived().empty());
+}
+
+TEST(Lockstep, ALostRsuAnsweringARecentClosedStepIsWaitedForAgain) {
+  Lockstep ls({"rsu_0"}, 1);
+  std::string reason;
+  ls.registerRsu("rsu_0", &reason);
+  std::vector<std::string> lost;
+  ls.beginStep(0);
+  ls.endStep(&lost);  // lost after one miss
+  ASSERT_FALSE(ls.isLive("rsu_0"));
+  // Its link comes back: answers arrive after their step closed (it is not waited for).
+  ls.beginStep(50);
+  ls.endStep(&lost);
+  EXPECT_EQ(ls.onAnswer("rsu_0", 30), Lockstep::Answer::kStale);  // 20 steps old: backlog
+  EXPECT_FALSE(ls.isLive("rsu_0"));
+  EXPECT_EQ(ls.onAnswer("rsu_0", 45), Lockstep::Answer::kStale);  // recent: it is back
+  EXPECT_TRUE(ls.isLive("rsu_0"));
+  EXPECT_EQ(ls.takeRevived(), std::vector<std::string>{"rsu_0"});
+  ls.beginStep(51);
+  EXPECT_FALSE(ls.complete());  // waited for again
+  EXPECT_EQ(ls.onAnswer("rsu_0", 51), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.complete());
 }
 
 TEST(Lockstep, NoRsusMeansNoLockstep) {

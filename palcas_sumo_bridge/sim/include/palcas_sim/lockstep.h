@@ -26,8 +26,13 @@ class Lockstep {
   /// Opens step `step`: from now on answers for it count.
   void beginStep(std::uint64_t step);
   enum class Answer { kAccepted, kUnknownRsu, kStale, kDuplicate };
-  /// Records that `rsu_id` answered `step`.
+  /// Records that `rsu_id` answered `step`. A lost RSU is live again when it answers the
+  /// open step, or a step at most REVIVE_WINDOW_STEPS old: a lost RSU is not waited for, so
+  /// its answers always come after its step closed (a network link that came back).
   Answer onAnswer(const std::string& rsu_id, std::uint64_t step);
+  static constexpr std::uint64_t REVIVE_WINDOW_STEPS = 10;
+  /// Lost RSUs revived by an answer since the last call (for the log), then cleared.
+  std::vector<std::string> takeRevived();
   /// True when every live, registered RSU has answered the open step.
   bool complete() const;
   /// Live RSUs that have not answered the open step yet.
@@ -53,6 +58,7 @@ class Lockstep {
   };
   std::map<std::string, RsuStatus> rsus_;
   int lost_after_;
+  std::vector<std::string> revived_;
   std::uint64_t open_step_ = 0;
   bool step_open_ = false;
   std::uint64_t late_steps_ = 0;
