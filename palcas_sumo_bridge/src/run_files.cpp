@@ -236,7 +236,11 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
     fs::create_directories(dir);
     writeAtomically(dir + "/metrics.json", out);
   }
-  // One row per episode (also for a single one), for learning curves.
+  // One row per finished episode (also for a single one), for learning curves and for
+  // ./palcas train --resume, which counts the rows: an episode cut short (SIGINT, or the
+  // supervisor killed) must be redone, not counted; its metrics.json above still says how
+  // far it got.
+  if (m.sim_seconds + 1e-6 < o.scenario.duration_s) return;
   const std::string csv = o.out_dir + "/episodes.csv";
   const bool fresh = !fs::exists(csv);
   std::ofstream rows(csv, std::ios::app);
