@@ -201,7 +201,8 @@ TEST(EpisodeMetrics, RejectsBadCountersAndTimesKeepingState) {
   EXPECT_THROW(acc.setSimSeconds(4.9), std::invalid_argument);  // time runs forward
   EXPECT_THROW(acc.setSimSeconds(INF), std::invalid_argument);
   EXPECT_DOUBLE_EQ(acc.snapshot().sim_seconds, 5.0);
-  EXPECT_THROW(acc.addAdvisoryRejected(static_cast<RejectionReason>(8)), std::invalid_argument);
+  EXPECT_THROW(acc.addAdvisoryRejected(static_cast<RejectionReason>(REJECTION_REASON_COUNT)),
+               std::invalid_argument);
   EXPECT_EQ(acc.snapshot().advisories_rejected, 0u);
 }
 

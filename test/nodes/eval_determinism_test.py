@@ -57,9 +57,11 @@ class EvalDeterminismTest(unittest.TestCase):
             runs.append(decisions(out + "/episode.bag"))
         a, b = runs
         # rosbag record connects to each RSU's /advisories on its own schedule (the bridge
-        # only waits for it on its own topics), so under load a bag can miss the first
-        # decisions: compare the steps both bags cover, and the full counts from metrics.json.
-        first = max(min(a)[0], min(b)[0])
+        # only waits for it on its own topics), so under load a bag can miss an RSU's first
+        # decisions: compare from the first step every RSU is in both bags, and the full
+        # counts from metrics.json.
+        rsus = {r for _, r in list(a) + list(b)}
+        first = max(min(step for step, r in run if r == rsu) for run in (a, b) for rsu in rsus)
         a = {k: v for k, v in a.items() if k[0] >= first}
         b = {k: v for k, v in b.items() if k[0] >= first}
         self.assertGreater(len(a), 50, "too few decisions to compare (from step %d)" % first)
