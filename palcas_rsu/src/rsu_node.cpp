@@ -3,14 +3,10 @@
 #include <palcas_common/message_auth.h>
 #include <palcas_common/model_weights.h>
 #include <palcas_msgs/AdvisoryArray.h>
-#include <palcas_msgs/FetchGlobalModel.h>
 #include <palcas_msgs/RegisterRsu.h>
 #include <palcas_msgs/RsuStatus.h>
-#include <palcas_msgs/SubmitWeights.h>
 
-#include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include "palcas_rsu/msg_conversion.h"
 #include "palcas_rsu/topics.h"
@@ -22,7 +18,9 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), private_nh_(private_nh), options_(loadRsuNodeOptions(private_nh_)),
       controller_(std::make_unique<RsuController>(options_.controller)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
-      peers_(options_.controller.cluster_index, options_.i2i_stale_after_s) {
+      peers_(options_.controller.cluster_index, options_.i2i_stale_after_s),
+      learning_log_(options_.checkpoint_dir.empty() ? "" : (fs::path(checkpointDir()) / "learning.csv").string(),
+                    options_.controller.rsu_id, options_.controller.train ? "train" : "eval") {
   const RsuControllerOptions& c = options_.controller;
   if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
     // A new training, or one that stopped before this RSU wrote anything: start afresh.
@@ -73,17 +71,21 @@ void RsuNode::loadInitialModel() {
     return;
   }
   if (!options_.federation) return;
-  submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
-  fetch_client_ = nh_.serviceClient<palcas_msgs::FetchGlobalModel>(FETCH_MODEL_SERVICE, true);
+  federated_model_ = std::make_unique<ControllerModel>(*controller_);
+  transport_ = std::make_unique<RosFederationTransport>(nh_, auth_key_.get(), submitted_pub_);
+  FederationClientOptions client;
+  client.rsu_id = c.rsu_id;
+  client.heartbeat_s = options_.federation_heartbeat_s;
+  federation_ = std::make_unique<FederationClient>(
+      client, *federated_model_, *transport_,
+      [this](FederationEvent e, const std::string& message) { onFederationEvent(e, message); });
   if (!ros::service::waitForService(nh_.resolveName(FETCH_MODEL_SERVICE),
                                     ros::Duration(options_.federation_wait_s))) {
     ROS_WARN("%s: federation server not reachable after %.0f s: starting from local weights; "
              "will join when it answers", c.rsu_id.c_str(), options_.federation_wait_s);
     return;
   }
-  // Every RSU starts from the server's model (FedAvg needs a common start); after a resume,
-  // only from a newer one: the one it already had would undo its local steps since.
-  fetchGlobal(controller_->modelVersion() == 0 ? 1 : controller_->modelVersion() + 1);
+  federation_->join();
 }
 
 void RsuNode::waitForPeers() {
@@ -211,15 +213,12 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
     controller_->learn();  // after publishing: the bridge need not wait for gradient steps
 
   ++decisions_;
-  if (episode_log_.active && msg.step <= episode_log_.last_step) endEpisodeLog();  // bridge restarted
-  const RsuControllerStats closed = controller_->stats();
-  episode_log_.active = true;
-  episode_log_.last_step = msg.step;
-  episode_log_.decisions++;
-  episode_log_.transitions += closed.transitions_closed;
-  episode_log_.reward_sum += closed.sum_reward;
-  episode_log_.decision_ms_sum += out.decision_ms;
-  if (c.train && options_.federation) federate(now_s);
+  try {
+    learning_log_.addDecision(msg.step, controller_->stats(), out.decision_ms);
+  } catch (const std::runtime_error& e) {
+    ROS_ERROR_THROTTLE(60.0, "%s: %s", c.rsu_id.c_str(), e.what());
+  }
+  if (c.train && federation_) federation_->onDecision(now_s);
   if (c.train && options_.checkpoint_every_decisions > 0 && !options_.checkpoint_dir.empty() &&
       decisions_ % static_cast<std::uint64_t>(options_.checkpoint_every_decisions) == 0)
     checkpoint();
@@ -243,99 +242,25 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   status.model_version = s.model_version;
   status.federation_round = s.federation_round;
   status.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
-  status.federation_reachable = federation_reachable_;
+  status.federation_reachable = federation_ && federation_->reachable();
   status_pub_.publish(status);
   // Last: federation and checkpoints above saw the model as the decision used it.
   if (options_.learner_thread && c.train)
     learner_ = std::async(std::launch::async, [this] { controller_->learn(); });
 }
 
-bool RsuNode::fetchGlobal(uint32_t min_version) {
-  palcas_msgs::FetchGlobalModel srv;
-  srv.request.rsu_id = options_.controller.rsu_id;
-  srv.request.min_version = min_version;
-  if (!fetch_client_.isValid())
-    fetch_client_ = nh_.serviceClient<palcas_msgs::FetchGlobalModel>(FETCH_MODEL_SERVICE, true);
-  federation_reachable_ = fetch_client_.call(srv);
-  if (!federation_reachable_) {
-    // A persistent client keeps its broken link after the server died and fails on the
-    // restarted one forever: drop it, the next call connects afresh.
-    fetch_client_.shutdown();
-    ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; advising with the local model",
-                      options_.controller.rsu_id.c_str());
-    return false;
-  }
-  if (!srv.response.available) return false;
-  const auth::Verdict verdict = common::verifyMessage(srv.response.weights, auth_key_.get());
-  if (verdict != auth::Verdict::kAuthentic) {
-    ROS_ERROR_THROTTLE(10.0, "%s: refused a global model that is not the server's (%s); keeping "
-                       "the local one", options_.controller.rsu_id.c_str(), auth::verdictName(verdict));
-    return false;
-  }
-  server_round_ = srv.response.weights.round;  // the round now open
-  try {
-    controller_->loadGlobalModel(common::toModelBlob(srv.response.weights),
-                                 srv.response.weights.model_version);
-    submitted_ = false;
-    model_pub_.publish(common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
-                                            server_round_, controller_->modelVersion(), 0));
-    ROS_INFO("%s: loaded global model version %u (round %u open)", options_.controller.rsu_id.c_str(),
-             srv.response.weights.model_version, server_round_);
-    return true;
-  } catch (const std::invalid_argument& e) {
-    ROS_ERROR("%s: refused the global model: %s; keeping the local one", options_.controller.rsu_id.c_str(),
-              e.what());
-    return false;
-  }
-}
-
-void RsuNode::federate(double now_s) {
-  // The sim clock restarts with every episode: a call "in the future" is from the last one.
-  if (last_server_call_s_ > now_s) last_server_call_s_ = now_s;
-  // Waiting for the round to close: poll without blocking the advisories.
-  if (submitted_) {
-    last_server_call_s_ = now_s;
-    fetchGlobal(controller_->modelVersion() + 1);
-    return;
-  }
-  if (!controller_->federationDue()) {
-    // Training between rounds: a heartbeat keeps this RSU live at the server (and picks up
-    // a global model that moved on without it).
-    if (options_.federation_heartbeat_s > 0 && now_s - last_server_call_s_ >= options_.federation_heartbeat_s) {
-      last_server_call_s_ = now_s;
-      fetchGlobal(controller_->modelVersion() + 1);
-    }
-    return;
-  }
-  last_server_call_s_ = now_s;
-  palcas_msgs::SubmitWeights srv;
-  srv.request.weights = common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
-                                             server_round_, controller_->modelVersion(),
-                                             controller_->samplesSinceFederation());
-  common::signMessage(srv.request.weights, auth_key_.get());
-  if (!submit_client_.isValid())
-    submit_client_ = nh_.serviceClient<palcas_msgs::SubmitWeights>(SUBMIT_WEIGHTS_SERVICE, true);
-  federation_reachable_ = submit_client_.call(srv);
-  if (!federation_reachable_) {
-    submit_client_.shutdown();  // as in fetchGlobal: reconnect on the next call
-    ROS_WARN_THROTTLE(10.0, "%s: federation server unreachable; will submit again later",
-                      options_.controller.rsu_id.c_str());
-    return;
-  }
-  server_round_ = srv.response.round;
-  if (srv.response.accepted) {
-    submitted_ = true;
-    submitted_pub_.publish(srv.request.weights);
-    ROS_INFO("%s: submitted model for round %u (n_k = %lu)", options_.controller.rsu_id.c_str(),
-             srv.request.weights.round, static_cast<unsigned long>(srv.request.weights.sample_count));
-  } else if (srv.response.global_version > controller_->modelVersion()) {
-    // The round moved on without us (we were late or away): take the newer global model.
-    ROS_WARN("%s: submission refused (%s); fetching global version %u", options_.controller.rsu_id.c_str(),
-             srv.response.reason.c_str(), srv.response.global_version);
-    fetchGlobal(srv.response.global_version);
-  } else {
-    ROS_WARN_THROTTLE(10.0, "%s: submission refused: %s", options_.controller.rsu_id.c_str(),
-                      srv.response.reason.c_str());
+void RsuNode::onFederationEvent(FederationEvent event, const std::string& message) {
+  // One log call per kind, so each kind is throttled on its own.
+  switch (event) {
+    case FederationEvent::kUnreachable: ROS_WARN_THROTTLE(10.0, "%s", message.c_str()); break;
+    case FederationEvent::kModelRefused: ROS_ERROR_THROTTLE(10.0, "%s", message.c_str()); break;
+    case FederationEvent::kSubmitRefused: ROS_WARN_THROTTLE(10.0, "%s", message.c_str()); break;
+    case FederationEvent::kSubmitted: ROS_INFO("%s", message.c_str()); break;
+    case FederationEvent::kLoaded:
+      model_pub_.publish(common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
+                                              federation_->openRound(), controller_->modelVersion(), 0));
+      ROS_INFO("%s", message.c_str());
+      break;
   }
 }
 
@@ -349,26 +274,11 @@ void RsuNode::checkpoint() {
 }
 
 void RsuNode::endEpisodeLog() {
-  if (!episode_log_.active || options_.checkpoint_dir.empty()) {
-    episode_log_ = EpisodeLog{};
-    return;
+  try {
+    learning_log_.endEpisode(controller_->stats());
+  } catch (const std::runtime_error& e) {
+    ROS_ERROR("%s: %s", options_.controller.rsu_id.c_str(), e.what());
   }
-  fs::create_directories(checkpointDir());
-  const fs::path path = fs::path(checkpointDir()) / "learning.csv";
-  const bool fresh = !fs::exists(path);
-  std::ofstream rows(path, std::ios::app);
-  if (fresh)
-    rows << "rsu_id,mode,decisions,transitions,mean_reward,sum_reward,epsilon,gradient_steps,"
-            "q_loss,param_loss,model_version,federation_round,decision_ms_mean\n";
-  const RsuControllerStats s = controller_->stats();
-  const EpisodeLog& e = episode_log_;
-  rows << options_.controller.rsu_id << ',' << (options_.controller.train ? "train" : "eval") << ','
-       << e.decisions << ',' << e.transitions << ','
-       << (e.transitions ? e.reward_sum / e.transitions : std::nan("")) << ',' << e.reward_sum << ','
-       << s.epsilon << ',' << s.gradient_steps << ',' << s.q_loss << ',' << s.param_loss << ','
-       << s.model_version << ',' << s.federation_round << ','
-       << (e.decisions ? e.decision_ms_sum / e.decisions : 0.0) << '\n';
-  episode_log_ = EpisodeLog{};
 }
 
 void RsuNode::shutdown() {

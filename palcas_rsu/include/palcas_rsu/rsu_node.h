@@ -5,6 +5,9 @@
 // publishes the advisories, its ClusterState (I2I) and its RsuStatus; in train mode it runs
 // the federation exchange without blocking the advisories.
 
+#include <palcas_core/controller_model.h>
+#include <palcas_core/federation_client.h>
+#include <palcas_core/learning_log.h>
 #include <palcas_core/message_auth.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
@@ -17,6 +20,7 @@
 #include <memory>
 #include <string>
 
+#include "palcas_rsu/federation_transport.h"
 #include "palcas_rsu/peer_states.h"
 #include "palcas_rsu/rsu_options.h"
 
@@ -41,13 +45,12 @@ class RsuNode {
   void waitForPeers();
   void registerWithBridge();
   void loadInitialModel();
-  /// now_s: the decision's sim time (heartbeats are paced by it).
-  void federate(double now_s);
-  bool fetchGlobal(uint32_t min_version);
+  /// Logs what the federation client did; publishes the model after a load.
+  void onFederationEvent(FederationEvent event, const std::string& message);
   void checkpoint();
   /// Signs (with a key) and publishes one step's answer.
   void publishAdvisories(palcas_msgs::AdvisoryArray& out);
-  /// Appends this episode's learning row to <checkpoint_dir>/<rsu_id>/learning.csv.
+  /// Closes this episode's row of learning.csv (errors logged, not thrown).
   void endEpisodeLog();
   std::string checkpointDir() const;
 
@@ -64,27 +67,17 @@ class RsuNode {
 
   ros::Publisher advisories_pub_, cluster_pub_, status_pub_, submitted_pub_, model_pub_;
   ros::Subscriber states_sub_, events_sub_, cluster_sub_;
-  ros::ServiceClient submit_client_, fetch_client_;
+  // Federation (train mode with federation on): the client's state machine in the core,
+  // reaching the server through ROS services.
+  std::unique_ptr<ControllerModel> federated_model_;
+  std::unique_ptr<RosFederationTransport> transport_;
+  std::unique_ptr<FederationClient> federation_;
 
   std::uint64_t decisions_ = 0;
-  // This episode's learning figures (train mode), for learning.csv.
-  struct EpisodeLog {
-    bool active = false;
-    std::uint64_t last_step = 0;
-    std::uint64_t decisions = 0;
-    std::uint64_t transitions = 0;
-    double reward_sum = 0.0;
-    double decision_ms_sum = 0.0;
-  } episode_log_;
+  LearningLog learning_log_;  ///< <checkpoint_dir>/<rsu_id>/learning.csv, a row per episode
   /// This zone's density at the previous decision: the "own" global density (veh/km).
   double last_own_density_ = std::numeric_limits<double>::quiet_NaN();
   bool first_state_ = true;
-  // Federation round state: the open round as the server last said, whether this RSU
-  // has submitted in it, and whether the server answered the last call.
-  uint32_t server_round_ = 0;
-  bool submitted_ = false;
-  bool federation_reachable_ = false;
-  double last_server_call_s_ = -1e300;  ///< sim time of the last call to the server
 };
 
 }  // namespace palcas::rsu
