@@ -42,7 +42,8 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road())),
       rules_(measureRules(options_, session_->road())),
       measure_(std::make_unique<EpisodeMeasure>(rules_)),
-      auth_key_(common::loadMessageKey(options_.auth_key_file)) {
+      auth_key_(common::loadMessageKey(options_.auth_key_file)),
+      holds_(static_cast<std::uint64_t>(options_.advisory_hold_steps)) {
   completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(), rules_);
   advertise();
   advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
@@ -267,24 +268,14 @@ void BridgeNode::applyAdvisories() {
       }
       advised.insert(a.vehicle_id);
       advised_actions.emplace_back(a.vehicle_id, a.action);
-      controlled_[a.vehicle_id] = Control{array->rsu_id, step};
+      holds_.advised(a.vehicle_id, array->rsu_id, step);
       measure_->metrics().addAdvisoriesApplied();
     }
   }
   pending_.clear();
-  // Without a fresh advisory a CAV holds its command until it expires; if its RSU is late
-  // (or lost) it keeps its speed at once.
-  const auto hold = static_cast<std::uint64_t>(options_.advisory_hold_steps);
-  for (auto it = controlled_.begin(); it != controlled_.end();) {
-    if (!session_->find(it->first)) {
-      it = controlled_.erase(it);
-      continue;
-    }
-    if (!advised.count(it->first) &&
-        (late_this_step_.count(it->second.rsu_id) || step >= it->second.step + hold))
-      session_->endCommand(it->first);
-    ++it;
-  }
+  for (const std::string& id :
+       holds_.ending(step, late_this_step_, [this](const std::string& id) { return session_->find(id) != nullptr; }))
+    session_->endCommand(id);
   late_this_step_.clear();
   const std::uint64_t k = session_->stepCount();
   if (k % static_cast<std::uint64_t>(options_.markers_every_steps) == 0 &&
@@ -314,7 +305,7 @@ void BridgeNode::startEpisode(int episode) {
   session_.reset();  // closes SUMO before the next one loads (one libsumo per process)
   session_ = std::make_unique<sim::SumoSession>(sessionOptionsFor(options_, sumocfg_path_, episode));
   measure_ = std::make_unique<EpisodeMeasure>(rules_);
-  controlled_.clear();
+  holds_.clear();
   pending_.clear();
   late_by_rsu_.clear();
   decision_ms_.clear();

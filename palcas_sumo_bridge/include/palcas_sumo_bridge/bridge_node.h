@@ -18,6 +18,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "palcas_sim/advisory_holds.h"
 #include "palcas_sim/lockstep.h"
 #include "palcas_sim/run_recorder.h"
 #include "palcas_sim/sumo_session.h"
@@ -77,13 +78,9 @@ class BridgeNode {
   palcas_msgs::VehicleStateArray current_states_;
   /// Advisory arrays received for the open step, by RSU, in arrival order.
   std::vector<palcas_msgs::AdvisoryArray::ConstPtr> pending_;
-  /// Who advised a CAV last and at which step: its command holds for advisory_hold_steps,
-  /// unless that RSU is late, then the CAV keeps its speed.
-  struct Control {
-    std::string rsu_id;
-    std::uint64_t step = 0;
-  };
-  std::unordered_map<std::string, Control> controlled_;
+  /// Who advised each CAV last and when: its command holds for advisory_hold_steps,
+  /// unless that RSU is late, then its own driving takes over.
+  sim::AdvisoryHolds holds_;
   std::unordered_set<std::string> late_this_step_;
   std::map<std::string, std::uint64_t> late_by_rsu_;
   std::vector<float> decision_ms_;  ///< this episode's RSU decision latencies [ms]

@@ -1,5 +1,6 @@
 palcas_sim_add_gtest(road_layout_test test/road_layout_test.cpp)
 palcas_sim_add_gtest(lockstep_test test/lockstep_test.cpp)
+palcas_sim_add_gtest(advisory_holds_test test/advisory_holds_test.cpp)
 palcas_sim_add_gtest(run_recorder_test test/run_recorder_test.cpp)
 palcas_sim_add_gtest(sumo_session_test test/sumo_session_test.cpp)
 if(TARGET sumo_session_test)

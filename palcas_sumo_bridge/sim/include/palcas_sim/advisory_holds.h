@@ -1,0 +1,45 @@
+#pragma once
+// The bridge's advisory-hold policy, without ROS or SUMO: an advised CAV holds its
+// command for hold_steps bridge steps after the advisory, unless a newer advisory
+// replaces it; if the RSU that advised it is late at a step (or lost), the command ends
+// at once and the CAV's own driving takes over (bridge README, "What a CAV does").
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace palcas::sim {
+
+class AdvisoryHolds {
+ public:
+  /// @throws std::invalid_argument if hold_steps < 1.
+  explicit AdvisoryHolds(std::uint64_t hold_steps);
+
+  /// `rsu_id` advised `vehicle_id` at bridge step `step` (replaces its previous hold).
+  void advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step);
+
+  /// The vehicles whose command ends at `step`: not advised at this step, and either their
+  /// hold ran out (step >= advised step + hold_steps) or their RSU is in `late_rsus`.
+  /// They stay known (their command is ended again at later steps until a new advisory:
+  /// ending a command is idempotent in the session) until `on_road` says they left, then
+  /// they are forgotten.
+  std::vector<std::string> ending(std::uint64_t step, const std::unordered_set<std::string>& late_rsus,
+                                  const std::function<bool(const std::string&)>& on_road);
+
+  void clear() { holds_.clear(); }
+  std::size_t size() const { return holds_.size(); }
+  std::uint64_t holdSteps() const { return hold_steps_; }
+
+ private:
+  struct Hold {
+    std::string rsu_id;
+    std::uint64_t step = 0;
+  };
+  std::uint64_t hold_steps_;
+  std::unordered_map<std::string, Hold> holds_;
+};
+
+}  // namespace palcas::sim

@@ -1,0 +1,32 @@
+#include "palcas_sim/advisory_holds.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace palcas::sim {
+
+AdvisoryHolds::AdvisoryHolds(std::uint64_t hold_steps) : hold_steps_(hold_steps) {
+  if (hold_steps < 1) throw std::invalid_argument("advisory holds: hold_steps must be >= 1, got 0");
+}
+
+void AdvisoryHolds::advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step) {
+  holds_[vehicle_id] = Hold{rsu_id, step};
+}
+
+std::vector<std::string> AdvisoryHolds::ending(std::uint64_t step, const std::unordered_set<std::string>& late_rsus,
+                                               const std::function<bool(const std::string&)>& on_road) {
+  std::vector<std::string> out;
+  for (auto it = holds_.begin(); it != holds_.end();) {
+    if (!on_road(it->first)) {
+      it = holds_.erase(it);
+      continue;
+    }
+    const Hold& h = it->second;
+    if (h.step != step && (late_rsus.count(h.rsu_id) || step >= h.step + hold_steps_)) out.push_back(it->first);
+    ++it;
+  }
+  std::sort(out.begin(), out.end());  // a stable order for callers and tests
+  return out;
+}
+
+}  // namespace palcas::sim

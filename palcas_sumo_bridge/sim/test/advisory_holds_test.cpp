@@ -1,0 +1,50 @@
+#include "palcas_sim/advisory_holds.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+using palcas::sim::AdvisoryHolds;
+
+namespace {
+using Ids = std::vector<std::string>;
+const std::unordered_set<std::string> NONE_LATE;
+std::function<bool(const std::string&)> onRoad(std::set<std::string> ids) {
+  return [ids](const std::string& id) { return ids.count(id) > 0; };
+}
+}  // namespace
+
+TEST(AdvisoryHolds, ACommandHoldsForItsStepsThenEnds) {
+  AdvisoryHolds holds(10);
+  holds.advised("cav", "rsu_0", 100);
+  const auto road = onRoad({"cav"});
+  for (std::uint64_t step = 100; step < 110; ++step) EXPECT_EQ(holds.ending(step, NONE_LATE, road), Ids{}) << step;
+  EXPECT_EQ(holds.ending(110, NONE_LATE, road), Ids{"cav"});
+  EXPECT_EQ(holds.ending(111, NONE_LATE, road), Ids{"cav"});  // ended again until re-advised
+}
+
+TEST(AdvisoryHolds, ANewAdvisoryRestartsTheHold) {
+  AdvisoryHolds holds(10);
+  holds.advised("cav", "rsu_0", 100);
+  holds.advised("cav", "rsu_1", 105);  // handed over to the next zone
+  EXPECT_EQ(holds.ending(110, NONE_LATE, onRoad({"cav"})), Ids{});
+  EXPECT_EQ(holds.ending(115, NONE_LATE, onRoad({"cav"})), Ids{"cav"});
+}
+
+TEST(AdvisoryHolds, ALateRsuEndsItsCommandsAtOnceButNotOthers) {
+  AdvisoryHolds holds(10);
+  holds.advised("a", "rsu_0", 100);
+  holds.advised("b", "rsu_1", 100);
+  holds.advised("c", "rsu_0", 102);  // advised at this very step: kept
+  EXPECT_EQ(holds.ending(102, {"rsu_0"}, onRoad({"a", "b", "c"})), Ids{"a"});
+}
+
+TEST(AdvisoryHolds, VehiclesThatLeftAreForgotten) {
+  AdvisoryHolds holds(1);
+  holds.advised("a", "rsu_0", 1);
+  holds.advised("b", "rsu_0", 1);
+  EXPECT_EQ(holds.ending(5, NONE_LATE, onRoad({"b"})), Ids{"b"});
+  EXPECT_EQ(holds.size(), 1u);
+}
+
+TEST(AdvisoryHolds, RefusesAZeroHold) { EXPECT_THROW(AdvisoryHolds(0), std::invalid_argument); }
