@@ -8,8 +8,8 @@
 
 namespace palcas::fedserver {
 
-FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh) {
-  palcas::common::ParamReader p(private_nh);
+FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh, common::ParamDefaults* defaults) {
+  palcas::common::ParamReader p(private_nh, defaults);
   FedServerOptions o;
   // The same loader as the RSUs': both build the same network from the same files.
   o.learning = params::loadPdqnConfig(p);

@@ -2,6 +2,7 @@
 // ~tiny), and its refusals, each naming the key. Broken cases copy ~shipped into their own
 // namespace and change one thing.
 #include <gtest/gtest.h>
+#include <palcas_common/param_defaults.h>
 #include <ros/ros.h>
 
 #include "palcas_fedserver/fedserver_options.h"
@@ -49,6 +50,14 @@ TEST(FedServerOptions, ShippedFilesLoad) {
   EXPECT_EQ(o.learning.seed, 1u);
   EXPECT_EQ(o.checkpoint_dir, "");
   EXPECT_FALSE(o.resume);
+}
+
+TEST(FedServerOptions, EveryKeyOfTheDefaultFilesEqualsTheCompiledInDefault) {
+  palcas::common::ParamDefaults defaults;
+  loadFedServerOptions(ros::NodeHandle("~empty"), &defaults);
+  ASSERT_GT(defaults.values.size(), 25u);
+  for (const std::string& line : palcas::common::defaultsDisagreeing(ros::NodeHandle("~defaults"), defaults))
+    ADD_FAILURE() << line;
 }
 
 TEST(FedServerOptions, TestOverridesLoad) {

@@ -8,8 +8,8 @@
 
 namespace palcas::rsu {
 
-RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh) {
-  palcas::common::ParamReader p(private_nh);
+RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::ParamDefaults* defaults) {
+  palcas::common::ParamReader p(private_nh, defaults);
   RsuNodeOptions o;
   RsuControllerOptions& c = o.controller;
   c.rsu_id = p.get<std::string>("rsu/rsu_id", c.rsu_id);

@@ -64,8 +64,8 @@ sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::Node
 
 }  // namespace
 
-BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh) {
-  palcas::common::ParamReader p(private_nh);
+BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::ParamDefaults* defaults) {
+  palcas::common::ParamReader p(private_nh, defaults);
   BridgeOptions o;
   o.scenario = loadScenario(p, private_nh);
   o.scenario.scenario_dir = p.get<std::string>("scenario_dir", "");

@@ -3,12 +3,15 @@
 // loader is the only code that calls it; it remembers every key it was asked for, so a key
 // nobody asked for (a typo in a YAML file) is reported by rejectUnknownKeys() instead of
 // being silently ignored. Errors are std::invalid_argument naming the full parameter name.
-// Header-only, next to the message contract because every node depends on palcas_msgs.
+// It can also record every key's compiled-in default (ParamDefaults), so a test can prove
+// that the shipped YAML and the structs agree (param_defaults.h). Header-only.
 
 #include <ros/node_handle.h>
 
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -16,9 +19,35 @@
 
 namespace palcas::common {
 
+/// Canonical text of a parameter value, the same for a compiled-in default and a value
+/// read from YAML: numbers with 6 significant digits (float fields compare equal to their
+/// YAML decimal), bools as true/false, lists as [a,b].
+inline std::string paramText(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+inline std::string paramText(int v) { return paramText(static_cast<double>(v)); }
+inline std::string paramText(bool v) { return v ? "true" : "false"; }
+inline std::string paramText(const std::string& v) { return v; }
+template <typename T>
+std::string paramText(const std::vector<T>& values) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + paramText(values[i]);
+  return out + "]";
+}
+
+/// Every optional key a loader read, with the default it would have used (paramText).
+struct ParamDefaults {
+  std::map<std::string, std::string> values;
+  std::set<std::string> required;  ///< keys without a default
+};
+
 class ParamReader {
  public:
-  explicit ParamReader(const ros::NodeHandle& nh) : nh_(nh) {}
+  /// defaults: if set, every key's compiled-in default is recorded there.
+  explicit ParamReader(const ros::NodeHandle& nh, ParamDefaults* defaults = nullptr)
+      : nh_(nh), defaults_(defaults) {}
 
   bool has(const std::string& key) const { return nh_.hasParam(key); }
   std::string fullName(const std::string& key) const { return nh_.resolveName(key); }
@@ -27,6 +56,7 @@ class ParamReader {
   template <typename T>
   T get(const std::string& key, const T& fallback) {
     known_.insert(key);
+    if (defaults_) defaults_->values[key] = paramText(fallback);
     T value = fallback;
     if (nh_.hasParam(key) && !nh_.getParam(key, value))
       throw std::invalid_argument("parameter '" + fullName(key) + "' has the wrong type");
@@ -36,6 +66,7 @@ class ParamReader {
   /// A required key: missing or of the wrong type is an error naming it.
   template <typename T>
   T require(const std::string& key) {
+    if (defaults_) defaults_->required.insert(key);
     if (!nh_.hasParam(key)) {
       known_.insert(key);
       throw std::invalid_argument("parameter '" + fullName(key) + "' is missing");
@@ -93,6 +124,7 @@ class ParamReader {
   }
 
   const ros::NodeHandle& nh_;
+  ParamDefaults* defaults_;
   std::set<std::string> known_;
 };
 

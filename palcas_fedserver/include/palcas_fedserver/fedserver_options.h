@@ -3,6 +3,7 @@
 // (loadFedServerOptions, the only caller of getParam). Meaning, defaults and ranges:
 // README.md of this package and config/fedserver.yaml; ~learning/*: config/learning.yaml.
 
+#include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
 
 #include <string>
@@ -27,6 +28,7 @@ struct FedServerOptions {
 /// Reads the node's private parameters. @throws std::invalid_argument naming the key for
 /// a missing required key, a wrong type, a value out of range, or an unknown key under
 /// the node's namespace (a typo is an error, not a silent default).
-FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh);
+FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh,
+                                  common::ParamDefaults* defaults = nullptr);
 
 }  // namespace palcas::fedserver

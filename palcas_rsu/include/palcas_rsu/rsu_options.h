@@ -4,6 +4,7 @@
 // ~state_scales/*), config/reward.yaml (~reward/*), config/learning.yaml (~learning/*).
 
 #include <palcas_core/rsu_controller.h>
+#include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
 
 #include <string>
@@ -16,18 +17,18 @@ struct RsuNodeOptions {
   /// Zone boundaries of the scenario (~zones_m); RSU k manages [zones[k], zones[k+1]).
   std::vector<double> zones_m;
   bool whole_road = false;           ///< centralized baseline: one zone over every cluster
-  int decision_period_steps = 1;     ///< bridge steps between decisions
+  int decision_period_steps = 10;    ///< bridge steps between decisions (1 s at 0.1 s steps)
   /// true: a decision's gradient steps run on a worker thread while the simulation goes
   /// on, joined before the next decision (same result as inline: the next decision sees
   /// the same weights). false: inline, after publishing the advisories.
-  bool learner_thread = false;
+  bool learner_thread = true;
   std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
   std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
   /// The deployment's key file (palcas_core/message_auth.h): advisories and submissions are
   /// signed with it, a global model without its tag is refused. "" = authentication off.
   std::string auth_key_file;
   bool resume = false;               ///< continue from the checkpoint in checkpoint_dir
-  int checkpoint_every_decisions = 0;  ///< 0 = only at shutdown
+  int checkpoint_every_decisions = 600;  ///< 0 = only at shutdown; 600 = every 10 sim minutes
   bool federation = true;            ///< false: no federation server (baselines)
   double federation_wait_s = 30.0;   ///< wall time to wait for the server at start [s]
   /// Sim time between heartbeat fetches while training between rounds [s], so the server
@@ -39,6 +40,7 @@ struct RsuNodeOptions {
 };
 
 /// @throws std::invalid_argument naming the key for a bad, unknown or missing parameter.
-RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh);
+RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh,
+                                  common::ParamDefaults* defaults = nullptr);
 
 }  // namespace palcas::rsu

@@ -3,6 +3,7 @@
 // (loadBridgeOptions, the only caller of getParam). Defaults and meaning: README.md of
 // this package and config/bridge.yaml.
 
+#include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
 
 #include <string>
@@ -41,7 +42,7 @@ struct BridgeOptions {
   int advisory_hold_steps = 10;
   // Pace and outputs.
   double real_time_factor = 0.0;   ///< 0 = as fast as possible; e.g. 1.0 = real time
-  double metrics_period_s = 10.0;  ///< simulated time between EpisodeMetrics messages [s]
+  double metrics_period_s = 60.0;  ///< simulated time between EpisodeMetrics messages [s]
   double linger_s = 1.0;           ///< wall time to stay up after the episode, so subscribers drain [s]
   /// Record trajectories.csv (every vehicle every N steps) and decisions.csv into the run
   /// folder (episode_<k>/ when several episodes); 0 = record nothing.
@@ -58,6 +59,7 @@ struct BridgeOptions {
 /// Reads the private parameters of the node, ~scenario/* included. @throws
 /// std::invalid_argument naming the key for a value out of range, a wrong type, or an
 /// unknown key under the node's namespace.
-BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh);
+BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh,
+                                  common::ParamDefaults* defaults = nullptr);
 
 }  // namespace palcas::bridge

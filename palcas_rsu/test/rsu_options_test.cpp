@@ -1,0 +1,103 @@
+// The RSU node's parameter loader: the shipped files load, their defaults are the structs'
+// (one source for every default), and bad values are refused naming the key. Cases copy
+// ~shipped into their own namespace and change one thing.
+#include <gtest/gtest.h>
+#include <palcas_common/param_defaults.h>
+#include <ros/ros.h>
+
+#include <cmath>
+#include <functional>
+
+#include "palcas_rsu/rsu_options.h"
+
+using palcas::rsu::loadRsuNodeOptions;
+
+namespace {
+
+ros::NodeHandle caseFrom(const std::string& name, const std::function<void(ros::NodeHandle&)>& change) {
+  ros::NodeHandle shipped("~shipped"), nh("~" + name);
+  XmlRpc::XmlRpcValue all;
+  EXPECT_TRUE(shipped.getParam("", all));
+  nh.deleteParam("");
+  nh.setParam("", all);
+  change(nh);
+  return nh;
+}
+
+void expectRefused(const std::string& name, const std::function<void(ros::NodeHandle&)>& change,
+                   const std::string& needle) {
+  const ros::NodeHandle nh = caseFrom(name, change);
+  try {
+    loadRsuNodeOptions(nh);
+    ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(RsuOptions, ShippedFilesLoadForTheSecondZone) {
+  const auto o = loadRsuNodeOptions(ros::NodeHandle("~shipped"));
+  EXPECT_EQ(o.controller.rsu_id, "rsu_1");
+  EXPECT_DOUBLE_EQ(o.controller.x_start_m, 800.0);  // from zones_m, not rsu.yaml
+  EXPECT_DOUBLE_EQ(o.controller.x_end_m, 1600.0);
+  EXPECT_EQ(o.controller.num_lanes, 5);
+  EXPECT_EQ(o.decision_period_steps, 10);
+  EXPECT_TRUE(o.controller.reward_over_period);  // departures.yaml
+  EXPECT_FLOAT_EQ(o.controller.pdqn.gamma, 0.97f);
+  EXPECT_DOUBLE_EQ(o.federation_heartbeat_s, 10.0);
+}
+
+TEST(RsuOptions, EveryKeyOfTheDefaultFilesEqualsTheCompiledInDefault) {
+  palcas::common::ParamDefaults defaults;
+  try {
+    loadRsuNodeOptions(ros::NodeHandle("~empty"), &defaults);  // nothing set: every default
+  } catch (const std::invalid_argument&) {
+    // An empty rsu_id is refused at the end; every key was read (and recorded) before.
+  }
+  ASSERT_GT(defaults.values.size(), 50u);
+  const auto disagree = palcas::common::defaultsDisagreeing(ros::NodeHandle("~defaults"), defaults);
+  for (const std::string& line : disagree) ADD_FAILURE() << line;
+}
+
+TEST(RsuOptions, TheDefaultsCheckCanFail) {
+  palcas::common::ParamDefaults defaults;
+  try {
+    loadRsuNodeOptions(ros::NodeHandle("~empty"), &defaults);
+  } catch (const std::invalid_argument&) {
+  }
+  const ros::NodeHandle drifted = caseFrom("drifted", [](ros::NodeHandle& nh) {
+    nh.setParam("rsu/decision_period_steps", 7);  // shipped: 10
+    nh.setParam("rsu/no_such_key", 1);
+  });
+  const auto disagree = palcas::common::defaultsDisagreeing(drifted, defaults);
+  auto mentions = [&](const std::string& needle) {
+    for (const std::string& line : disagree)
+      if (line.find(needle) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(mentions("rsu/decision_period_steps: YAML 7, compiled-in default 10"));
+  EXPECT_TRUE(mentions("rsu/no_such_key: not read by the loader"));
+}
+
+TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
+  expectRefused("typo", [](ros::NodeHandle& nh) { nh.setParam("rsu/decision_period_step", 5); },
+                "rsu/decision_period_step");
+  expectRefused("lanes", [](ros::NodeHandle& nh) { nh.setParam("rsu/num_lanes", 0); }, "rsu/num_lanes");
+  expectRefused("zone", [](ros::NodeHandle& nh) { nh.setParam("rsu/cluster_index", 3); }, "has 3 zone(s)");
+  expectRefused("order", [](ros::NodeHandle& nh) { nh.setParam("zones_m", std::vector<double>{0, 800, 700}); },
+                "must increase");
+  expectRefused("period", [](ros::NodeHandle& nh) { nh.setParam("rsu/decision_period_steps", 2.5); },
+                "not a whole number");
+  expectRefused("type", [](ros::NodeHandle& nh) { nh.setParam("rsu/train", std::string("yes")); },
+                "rsu/train' has the wrong type");
+  expectRefused("resume", [](ros::NodeHandle& nh) { nh.setParam("resume", true); }, "nothing to resume from");
+  expectRefused("nan", [](ros::NodeHandle& nh) { nh.setParam("reward/iota", std::nan("")); }, "reward/iota");
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "rsu_options_test");
+  return RUN_ALL_TESTS();
+}
