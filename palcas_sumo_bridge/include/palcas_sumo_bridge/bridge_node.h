@@ -82,6 +82,7 @@ class BridgeNode {
   struct Control {
     std::string rsu_id;
     std::uint64_t step = 0;
+    int action = -1;  ///< the advised action while it holds; -1 once control returned
   };
   std::unordered_map<std::string, Control> controlled_;
   std::unordered_set<std::string> late_this_step_;
