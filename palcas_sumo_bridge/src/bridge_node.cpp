@@ -39,7 +39,8 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       session_(std::make_unique<sim::SumoSession>(sessionOptionsFor(options_, sumocfg_path_))),
       lockstep_(std::make_unique<sim::Lockstep>(options_.expected_rsus,
                                                 options_.lost_after_missed_steps)),
-      markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road())),
+      markers_(std::make_unique<RvizMarkers>(session_->laneShapes(), session_->road(),
+                                             prepareRvizView(options_, session_->laneShapes()))),
       rules_(measureRules(options_, session_->road())),
       measure_(std::make_unique<EpisodeMeasure>(rules_)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
@@ -241,7 +242,6 @@ void BridgeNode::applyAdvisories() {
   const std::uint64_t step = session_->stepCount();
   const int lanes = session_->road().numMainLanes();
   std::unordered_set<std::string> advised;
-  std::vector<std::pair<std::string, int>> advised_actions;
   for (const auto& array : pending_) {
     if (!array->advisories.empty()) {
       decision_ms_.push_back(array->decision_ms);
@@ -267,8 +267,7 @@ void BridgeNode::applyAdvisories() {
         continue;
       }
       advised.insert(a.vehicle_id);
-      advised_actions.emplace_back(a.vehicle_id, a.action);
-      holds_.advised(a.vehicle_id, array->rsu_id, step);
+      holds_.advised(a.vehicle_id, array->rsu_id, step, a.action);
       measure_->metrics().addAdvisoriesApplied();
     }
   }
@@ -279,9 +278,12 @@ void BridgeNode::applyAdvisories() {
   late_this_step_.clear();
   const std::uint64_t k = session_->stepCount();
   if (k % static_cast<std::uint64_t>(options_.markers_every_steps) == 0 &&
-      markers_pub_.getNumSubscribers() > 0)
+      markers_pub_.getNumSubscribers() > 0) {
+    // Every advisory in force, not only this step's: RSUs decide once a second, the markers
+    // go out every few steps, and an arrow should stay while its command holds.
     markers_pub_.publish(markers_->dynamicMarkers(ros::Time(session_->timeS()),
-                                                  session_->vehicles(), advised_actions));
+                                                  session_->vehicles(), holds_.inForce()));
+  }
 }
 
 void BridgeNode::publishMetrics() {

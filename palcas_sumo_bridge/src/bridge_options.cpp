@@ -108,6 +108,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.linger_s = p.number("linger", o.linger_s, 0.0, 60.0);
   o.markers_every_steps = p.integer("markers_every_steps", o.markers_every_steps, 1, 1000000);
   o.publish_tf = p.get<bool>("publish_tf", o.publish_tf);
+  o.rviz_template = p.get<std::string>("rviz_template", o.rviz_template);
+  if (o.rviz_template == "none") o.rviz_template.clear();  // the launch files' "not set"
   o.exit_miss_margin_m = p.number("exit_miss_margin", o.exit_miss_margin_m, 0.0, 1000.0);
   o.merge_stop_speed_mps = p.number("merge_stop_speed", o.merge_stop_speed_mps, 0.0, 10.0);
   o.merge_stop_window_m = p.number("merge_stop_window", o.merge_stop_window_m, 0.0, 1000.0);

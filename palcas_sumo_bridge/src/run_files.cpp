@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace palcas::bridge {
@@ -253,6 +254,28 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
        << m.collision_rate_pct << ',' << m.dsr_pct << ',' << m.msr_pct << ',' << m.comfort_share_pct
        << ',' << m.cavs_seen << ',' << m.exiting_cavs << ',' << m.merging_cavs << ','
        << m.advisories_applied << ',' << m.advisories_rejected << ',' << m.late_rsu_steps << '\n';
+}
+
+RoadView prepareRvizView(const BridgeOptions& options,
+                         const std::vector<std::vector<std::pair<double, double>>>& lane_shapes) {
+  if (options.rviz_template.empty()) return frameRoad(roadExtent(lane_shapes), WindowPx{});
+  std::ifstream in(options.rviz_template);
+  if (!in) throw std::runtime_error("~rviz_template '" + options.rviz_template + "': cannot read it");
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    const RoadView view = frameRoad(roadExtent(lane_shapes), windowOf(text.str()));
+    const std::string path = options.out_dir + "/palcas.rviz", tmp = path + ".tmp";
+    {
+      std::ofstream out(tmp);
+      out << withView(text.str(), view);
+      if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
+    }
+    fs::rename(tmp, path);
+    return view;
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error("~rviz_template '" + options.rviz_template + "': " + e.what());
+  }
 }
 
 }  // namespace palcas::bridge

@@ -60,6 +60,9 @@ check run_scenario_unknown     "--scenario 'nope'"          run --out "$OUT" --s
 check run_policy_missing       "--policy '/nonexistent'"    run --out "$OUT" --policy /nonexistent
 check run_arm_unknown          "--arm 'bogus'"              run --out "$OUT" --arm bogus
 check run_pr_without_value     "option --pr needs a value"  run --out "$OUT" --pr
+check run_real_time_factor_zero "--real-time-factor '0'"   run --out "$OUT" --rviz --real-time-factor 0
+check run_real_time_factor_text "--real-time-factor 'fast'" run --out "$OUT" --real-time-factor fast
+check run_real_time_factor_without_value "option --real-time-factor needs a value" run --out "$OUT" --real-time-factor
 check train_arm_keep           "--arm keep"                 train --out "$OUT" --arm keep
 check train_episodes_zero      "--episodes '0'"             train --out "$OUT" --episodes 0
 check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed

@@ -48,6 +48,9 @@ struct BridgeOptions {
   /// folder (episode_<k>/ when several episodes); 0 = record nothing.
   int trajectory_period_steps = 0;
   int markers_every_steps = 5;     ///< rviz markers every N steps (only with subscribers)
+  /// rviz configuration to frame on this road: written with the road's view as
+  /// <out_dir>/palcas.rviz; "" = write none (markers framed for a 1400x860 window).
+  std::string rviz_template;
   bool publish_tf = true;          ///< map -> vehicle and map -> RSU zone frames (only with subscribers)
   // Metrics rules.
   double exit_miss_margin_m = 20.0;   ///< on the mainline this far past its exit = missed [m]

@@ -13,6 +13,7 @@
 #include "palcas_sim/sumo_session.h"
 #include "palcas_sumo_bridge/bridge_options.h"
 #include "palcas_sumo_bridge/episode_measure.h"
+#include "palcas_sumo_bridge/rviz_view.h"
 
 namespace palcas::bridge {
 
@@ -72,5 +73,12 @@ MeasureRules readMeasureRules(const std::string& manifest_path);
 /// Writes the episode's metrics atomically (NaN as null) to <out_dir>/metrics.json, a row of
 /// <out_dir>/episodes.csv, and with several episodes <out_dir>/episode_<k>/metrics.json.
 void writeMetricsJson(const BridgeOptions& options, const RunSummary& summary, int episode);
+
+/// The view that frames the road in the window of ~rviz_template (rviz_view.h); with a
+/// template, also writes it with that view as <out_dir>/palcas.rviz (atomically: rviz
+/// may be waiting for the file). Without one, framed for rviz's default 1400x860 window.
+/// @throws std::runtime_error naming the template when it cannot be read or lacks a view.
+RoadView prepareRvizView(const BridgeOptions& options,
+                         const std::vector<std::vector<std::pair<double, double>>>& lane_shapes);
 
 }  // namespace palcas::bridge

@@ -9,8 +9,17 @@ AdvisoryHolds::AdvisoryHolds(std::uint64_t hold_steps) : hold_steps_(hold_steps)
   if (hold_steps < 1) throw std::invalid_argument("advisory holds: hold_steps must be >= 1, got 0");
 }
 
-void AdvisoryHolds::advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step) {
-  holds_[vehicle_id] = Hold{rsu_id, step};
+void AdvisoryHolds::advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step,
+                            int action) {
+  holds_[vehicle_id] = Hold{rsu_id, step, action};
+}
+
+std::vector<std::pair<std::string, int>> AdvisoryHolds::inForce() const {
+  std::vector<std::pair<std::string, int>> out;
+  for (const auto& [id, hold] : holds_)
+    if (hold.action >= 0) out.emplace_back(id, hold.action);
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 std::vector<std::string> AdvisoryHolds::ending(std::uint64_t step, const std::unordered_set<std::string>& late_rsus,
@@ -21,8 +30,11 @@ std::vector<std::string> AdvisoryHolds::ending(std::uint64_t step, const std::un
       it = holds_.erase(it);
       continue;
     }
-    const Hold& h = it->second;
-    if (h.step != step && (late_rsus.count(h.rsu_id) || step >= h.step + hold_steps_)) out.push_back(it->first);
+    Hold& h = it->second;
+    if (h.step != step && (late_rsus.count(h.rsu_id) || step >= h.step + hold_steps_)) {
+      out.push_back(it->first);
+      h.action = -1;
+    }
     ++it;
   }
   std::sort(out.begin(), out.end());  // a stable order for callers and tests

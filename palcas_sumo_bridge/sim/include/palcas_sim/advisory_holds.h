@@ -9,6 +9,7 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 namespace palcas::sim {
@@ -18,8 +19,9 @@ class AdvisoryHolds {
   /// @throws std::invalid_argument if hold_steps < 1.
   explicit AdvisoryHolds(std::uint64_t hold_steps);
 
-  /// `rsu_id` advised `vehicle_id` at bridge step `step` (replaces its previous hold).
-  void advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step);
+  /// `rsu_id` advised `vehicle_id` to take `action` at bridge step `step` (replaces its
+  /// previous hold).
+  void advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step, int action);
 
   /// The vehicles whose command ends at `step`: not advised at this step, and either their
   /// hold ran out (step >= advised step + hold_steps) or their RSU is in `late_rsus`.
@@ -29,6 +31,10 @@ class AdvisoryHolds {
   std::vector<std::string> ending(std::uint64_t step, const std::unordered_set<std::string>& late_rsus,
                                   const std::function<bool(const std::string&)>& on_road);
 
+  /// (vehicle, action) of every command still in force (not ended), sorted by vehicle:
+  /// what rviz draws as advisory arrows.
+  std::vector<std::pair<std::string, int>> inForce() const;
+
   void clear() { holds_.clear(); }
   std::size_t size() const { return holds_.size(); }
   std::uint64_t holdSteps() const { return hold_steps_; }
@@ -37,6 +43,7 @@ class AdvisoryHolds {
   struct Hold {
     std::string rsu_id;
     std::uint64_t step = 0;
+    int action = -1;  ///< -1 once the command ended and the CAV's own driving took over
   };
   std::uint64_t hold_steps_;
   std::unordered_map<std::string, Hold> holds_;
