@@ -91,6 +91,10 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.max_advised_accel_mps2 =
       p.number("max_advised_accel", o.session.max_advised_accel_mps2, 0.0, 20.0);
   o.session.remove_collided = p.get<bool>("remove_collided", o.session.remove_collided);
+  o.session.cav_max_accel_mps2 = p.number("cav_max_accel_mps2", o.session.cav_max_accel_mps2, 0.0, 20.0);
+  o.session.cav_max_decel_mps2 = p.number("cav_max_decel_mps2", o.session.cav_max_decel_mps2, 0.0, 20.0);
+  o.session.comfortable_lane_changes =
+      p.get<bool>("comfortable_lane_changes", o.session.comfortable_lane_changes);
   o.session.cluster_length_m = o.scenario.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
   o.lockstep_deadline_s = p.number("lockstep_deadline", o.lockstep_deadline_s, 0.001, 60.0);

@@ -296,6 +296,8 @@ void SumoSession::onDeparted(const std::string& id) {
   v.width_m = api::Vehicle::getWidth(id);
   v.max_speed_mps = api::Vehicle::getMaxSpeed(id);
   api::Vehicle::subscribe(id, vehicleVariables());
+  if (v.is_cav && options_.cav_max_accel_mps2 > 0.0) api::Vehicle::setAccel(id, options_.cav_max_accel_mps2);
+  if (v.is_cav && options_.cav_max_decel_mps2 > 0.0) api::Vehicle::setDecel(id, options_.cav_max_decel_mps2);
   if (v.is_cav && options_.advisory_control) {
     api::Vehicle::setSpeedMode(id, options_.cav_speed_mode);
     v.merge_mode = options_.own_merge && v.entry_cluster >= 0;  // ramp CAVs start on a ramp
@@ -434,11 +436,28 @@ bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
   return left_m >= v.speed_mps * time_s + v.length_m + 1.0;
 }
 
+void SumoSession::beginComfortableLaneChange(VehicleRecord& v) {
+  const double limit = options_.max_advised_accel_mps2;
+  if (!options_.comfortable_lane_changes || limit <= 0.0 || v.own_decel_mps2 > 0.0) return;
+  v.own_accel_mps2 = api::Vehicle::getAccel(v.id);
+  v.own_decel_mps2 = api::Vehicle::getDecel(v.id);
+  api::Vehicle::setAccel(v.id, std::min(limit, v.own_accel_mps2));
+  api::Vehicle::setDecel(v.id, std::min(limit, v.own_decel_mps2));
+}
+
+void SumoSession::endComfortableLaneChange(VehicleRecord& v) {
+  if (v.own_decel_mps2 <= 0.0) return;
+  api::Vehicle::setAccel(v.id, v.own_accel_mps2);
+  api::Vehicle::setDecel(v.id, v.own_decel_mps2);
+  v.own_accel_mps2 = v.own_decel_mps2 = 0.0;
+}
+
 void SumoSession::continueLaneChange(VehicleRecord& v) {
   if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
     // Done, or dropped after lane_change_duration_s (no safe gap found in time).
     ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
     v.lane_change_target = 0;
+    endComfortableLaneChange(v);
     return;
   }
   if (v.edge != v.lane_change_edge && wholeOnEdge(v))
@@ -457,6 +476,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
                                   "' has no lane " + std::to_string(target_lane));
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
+    beginComfortableLaneChange(v);
     // On a junction, or with its back still on one, the request waits until the vehicle is
     // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();

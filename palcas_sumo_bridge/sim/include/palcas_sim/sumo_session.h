@@ -55,6 +55,16 @@ struct SessionOptions {
   /// lane change registered on its neighbour lane: it aborts in getBackPositionOnLane or
   /// frees the vehicle twice (SIGSEGV in removePending), fixed only in SUMO 1.17.
   bool remove_collided = true;
+  /// CAVs' largest acceleration / deceleration [m/s^2] (SUMO's accel / decel of the
+  /// vehicle, set at insertion in every arm, advisory control or not); 0 = their vType's
+  /// own (2.6 / 4.5). An automated vehicle tuned for comfort; emergency braking beyond decel
+  /// stays possible (SUMO's emergencyDecel).
+  double cav_max_accel_mps2 = 0.0;
+  double cav_max_decel_mps2 = 0.0;
+  /// true: while an advised lane change is under way, the CAV's acceleration and
+  /// deceleration are bounded by max_advised_accel_mps2 (SUMO's lane-change model adapts
+  /// the speed to make the gap within the comfort band), restored when it ends.
+  bool comfortable_lane_changes = false;
 };
 
 /// One vehicle on the road, updated every step.
@@ -100,6 +110,8 @@ struct VehicleRecord {
   int lane_change_target = 0;       ///< paper lane, 0 = none
   double lane_change_until_s = 0.0; ///< simulation time the request expires
   std::string lane_change_edge;     ///< edge the request was last issued on
+  /// The vehicle's own accel / decel while comfortable_lane_changes bounds them (0 = not bounded).
+  double own_accel_mps2 = 0.0, own_decel_mps2 = 0.0;
 };
 
 /// What happened during one step besides vehicles moving.
@@ -173,6 +185,9 @@ class SumoSession {
   void updateDerived(VehicleRecord& v) const;
   void manageExit(VehicleRecord& v);
   void continueLaneChange(VehicleRecord& v);
+  /// comfortable_lane_changes: bound accel/decel for the advised change, then restore them.
+  void beginComfortableLaneChange(VehicleRecord& v);
+  void endComfortableLaneChange(VehicleRecord& v);
   bool wholeOnEdge(const VehicleRecord& v) const;
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
