@@ -14,15 +14,16 @@ import shutil
 import sys
 import tempfile
 import unittest
-from xml.sax.saxutils import quoteattr
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = pathlib.Path(__file__).resolve().parent / "fixtures" / "tiny_run"
 sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import experiment  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
+from junit_runner import run_as_junit  # noqa: E402
 
 
 def args(**kw):
@@ -251,46 +252,8 @@ class FiguresTest(unittest.TestCase):
                          "accel_profiles", "lane_trajectories"} <= names)
 
 
-class JUnitResult(unittest.TextTestResult):
-    def __init__(self, *a, **kw):
-        super().__init__(*a, **kw)
-        self.cases = []
-
-    def addSuccess(self, test):
-        super().addSuccess(test)
-        self.cases.append((test.id(), None))
-
-    def addFailure(self, test, err):
-        super().addFailure(test, err)
-        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
-
-    def addError(self, test, err):
-        super().addError(test, err)
-        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
-
-
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--xml")
-    a = ap.parse_args()
-    suite = unittest.defaultTestLoader.loadTestsFromModule(sys.modules[__name__])
-    result = unittest.TextTestRunner(resultclass=JUnitResult, verbosity=2).run(suite)
-    if a.xml:
-        pathlib.Path(a.xml).parent.mkdir(parents=True, exist_ok=True)
-        failed = sum(1 for _, f in result.cases if f)
-        with open(a.xml, "w") as f:
-            f.write('<?xml version="1.0" encoding="UTF-8"?>\n')
-            f.write(f'<testsuite name="experiment_tools" tests="{len(result.cases)}" '
-                    f'failures="{failed}" errors="0">\n')
-            for name, failure in result.cases:
-                cls, _, case = name.rpartition(".")
-                if failure:
-                    f.write(f'  <testcase classname={quoteattr(cls)} name={quoteattr(case)}>'
-                            f'<failure message={quoteattr(failure[-500:])}/></testcase>\n')
-                else:
-                    f.write(f'  <testcase classname={quoteattr(cls)} name={quoteattr(case)}/>\n')
-            f.write("</testsuite>\n")
-    sys.exit(0 if result.wasSuccessful() else 1)
+    run_as_junit(sys.modules[__name__], "experiment_tools")
 
 
 if __name__ == "__main__":

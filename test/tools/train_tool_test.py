@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""Tests of tools/train.py (./palcas train's orchestration) without a simulation: the
+options a resumed training settles on, the training record, and how a console log is read
+(nodes that died for good, why a simulation ended early).
+
+usage: train_tool_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
+import json
+import os
+import pathlib
+import sys
+import tempfile
+import unittest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import train  # noqa: E402
+from junit_runner import run_as_junit  # noqa: E402
+
+NOT_GIVEN = dict(arm=None, episodes=None, duration=None, pr=None, seed=None, scenario=None, explore_fraction=None)
+RECORD = {"arm": "independent", "scenario": "tiny", "pr": 40, "seed": 3, "episodes": 4, "duration_s": 300,
+          "learning": "/x/learning_schedule.yaml", "rsu_params": "", "bridge_params": "/b.yaml",
+          "paper_printed": False, "explore_fraction": 0.4, "git_commit": "abc"}
+
+
+def given(**kw):
+    g = dict(NOT_GIVEN)
+    g.update(kw)
+    return g
+
+
+class SettleOptions(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp()
+        with open(os.path.join(self.dir, "train.json"), "w") as f:
+            json.dump(RECORD, f)
+
+    def test_a_new_training_takes_defaults_for_what_was_not_given(self):
+        opts, record = train.settle_options(given(pr=20.0), "", resume=False)
+        self.assertIsNone(record)
+        self.assertEqual((opts["arm"], opts["pr"], opts["episodes"], opts["scenario"]), ("palcas", 20.0, 5, "paper"))
+
+    def test_a_new_training_refuses_a_folder_that_holds_one(self):
+        with self.assertRaisesRegex(train.OptionError, "already holds a training"):
+            train.settle_options(given(), self.dir, resume=False)
+
+    def test_resume_takes_everything_from_the_record(self):
+        opts, _ = train.settle_options(given(), self.dir, resume=True)
+        for option, key in (("arm", "arm"), ("scenario", "scenario"), ("pr", "pr"), ("seed", "seed"),
+                            ("duration", "duration_s"), ("episodes", "episodes"),
+                            ("explore_fraction", "explore_fraction"), ("bridge_params", "bridge_params"),
+                            ("learning", "learning")):
+            self.assertEqual(opts[option], RECORD[key], option)
+
+    def test_resume_may_grow_episodes_and_repeat_a_recorded_value(self):
+        opts, _ = train.settle_options(given(episodes=10, pr=40.0, arm="independent"), self.dir, resume=True)
+        self.assertEqual((opts["episodes"], opts["pr"]), (10, 40))
+
+    def test_resume_refuses_a_contradicting_flag_naming_both_values(self):
+        for kw, text in ((dict(pr=60.0), "trained with --pr 40, not --pr 60"),
+                         (dict(scenario="paper"), "trained with --scenario tiny, not --scenario paper"),
+                         (dict(seed=4), "trained with --seed 3, not --seed 4"),
+                         (dict(explore_fraction=0.5), "leave --explore-fraction out")):
+            with self.assertRaisesRegex(train.OptionError, text):
+                train.settle_options(given(**kw), self.dir, resume=True)
+
+    def test_resume_needs_a_record(self):
+        with self.assertRaisesRegex(train.OptionError, "holds no training to resume"):
+            train.settle_options(given(), tempfile.mkdtemp(), resume=True)
+        with open(os.path.join(self.dir, "train.json"), "w") as f:
+            f.write('{"arm": "palcas"}')
+        with self.assertRaisesRegex(train.OptionError, "no field 'scenario'"):
+            train.settle_options(given(), self.dir, resume=True)
+
+
+class Record(unittest.TestCase):
+    def test_paths_with_quotes_stay_valid_json_and_numbers_stay_as_written(self):
+        out = tempfile.mkdtemp(prefix='it\'s "quoted" \\ ')
+        opts = dict(train.DEFAULTS, pr=60.0, duration=1200.0, learning=out + "/l.yaml", rsu_params="",
+                    bridge_params="", paper_printed=False)
+        train.write_record(out, opts, "abc")
+        with open(os.path.join(out, "train.json")) as f:
+            record = json.load(f)
+        self.assertEqual(record["learning"], out + "/l.yaml")
+        self.assertEqual((record["pr"], record["duration_s"]), (60, 1200))
+        self.assertIsInstance(record["pr"], int)
+
+    def test_message_key_is_made_once_and_owner_only(self):
+        out = tempfile.mkdtemp()
+        key = train.message_key(out)
+        first = open(key).read()
+        self.assertEqual(len(first), 64)
+        self.assertEqual(os.stat(key).st_mode & 0o777, 0o600)
+        self.assertEqual(open(train.message_key(out)).read(), first)
+
+
+class ConsoleLog(unittest.TestCase):
+    def test_a_node_that_died_and_came_back_is_not_lost(self):
+        text = ("[rsu_0/rsu-4] process has died [pid 1, exit code -9, cmd x]\n"
+                "[rsu_0/rsu-4] restarting process\n")
+        self.assertEqual(train.node_deaths(text), [])
+
+    def test_a_death_without_restart_or_a_crash_loop_is_lost(self):
+        text = "\x1b[31m[rsu_1/rsu-5] process has died [pid 2, exit code 1, cmd x]\x1b[0m\n"
+        loop = "".join("[fedserver-3] process has died [pid %d, exit code -6, cmd x]\n"
+                       "[fedserver-3] restarting process\n" % k for k in range(3))
+        self.assertEqual(train.node_deaths(text + loop),
+                         ["fedserver-3 (exit code -6, died 3 times)", "rsu_1/rsu-5 (exit code 1)"])
+
+    def test_a_clean_exit_is_not_a_death(self):
+        self.assertEqual(train.node_deaths("[rsu_0/rsu-4] process has died [pid 1, exit code 0, cmd x]\n"), [])
+
+    def test_the_simulations_own_error_is_the_crash_reason(self):
+        text = ("[rsu_0/rsu-4] process has died [pid 1, exit code -15, cmd x]\n"
+                "sumo: MSVehicle.cpp:123: Assertion `myFurtherLanes.size() > 0' failed.\n")
+        self.assertIn("myFurtherLanes", train.crash_reason(text))
+        self.assertIn("process has died", train.crash_reason("[x] process has died [pid 1, exit code 1]"))
+        self.assertEqual(train.crash_reason("all fine"), "")
+        self.assertIn("[FATAL]", train.last_fatal("[ INFO] ok\n[FATAL] [1.0]: bad key\n"))
+
+    def test_clusters_come_from_the_roads_zones(self):
+        self.assertEqual(train.scenario_clusters(str(ROOT), "paper"), 3)
+        self.assertEqual(train.scenario_clusters(str(ROOT), "tiny"), 2)
+        self.assertEqual(train.rsu_ids("centralized", 3), ["central"])
+        self.assertEqual(train.rsu_ids("palcas", 2), ["rsu_0", "rsu_1"])
+
+
+if __name__ == "__main__":
+    run_as_junit(sys.modules[__name__], "train_tool")
