@@ -16,9 +16,9 @@ FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh, common:
   FederationOptions& f = o.federation;
   f.expected_rsus = p.require<std::vector<std::string>>("expected_rsus");
   f.quorum = static_cast<size_t>(p.integer("quorum", 0, 0, std::numeric_limits<int>::max()));
-  f.round_deadline_s = p.number("round_deadline", f.round_deadline_s, 1e-3, 1e9);
+  f.round_deadline_s = p.number("round_deadline_s", f.round_deadline_s, 1e-3, 1e9);
   f.liveness_timeout_s =
-      p.number("liveness_timeout", f.liveness_timeout_s, 1e-3, std::numeric_limits<double>::infinity());
+      p.number("liveness_timeout_s", f.liveness_timeout_s, 1e-3, std::numeric_limits<double>::infinity());
   f.max_samples = p.count("max_samples", f.max_samples, 1);
   f.max_update_norm_ratio = p.number("max_update_norm_ratio", f.max_update_norm_ratio, 0.0, 1e12);
   const std::string aggregation = p.get<std::string>("aggregation", "fedavg");
@@ -36,7 +36,7 @@ FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh, common:
                                 p.fullName("checkpoint_dir") + "' is empty: nothing to resume from");
   o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
   if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
-  o.poll_period_s = p.number("poll_period", o.poll_period_s, 1e-3, 3600.0);
+  o.poll_period_s = p.number("poll_period_s", o.poll_period_s, 1e-3, 3600.0);
   try {
     f.validate();
   } catch (const std::invalid_argument& e) {

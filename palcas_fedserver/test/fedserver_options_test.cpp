@@ -85,8 +85,8 @@ TEST(FedServerOptions, RefusesBadParametersNamingTheKey) {
                 "expected_rsus' is missing");
   expectRefused("wrong_type", [](ros::NodeHandle& n) { n.setParam("quorum", "two"); },
                 "quorum' has the wrong type");
-  expectRefused("range", [](ros::NodeHandle& n) { n.setParam("round_deadline", 0.0); },
-                "round_deadline' = 0");
+  expectRefused("range", [](ros::NodeHandle& n) { n.setParam("round_deadline_s", 0.0); },
+                "round_deadline_s' = 0");
   expectRefused("quorum", [](ros::NodeHandle& n) { n.setParam("quorum", 4); }, "quorum = 4");
   expectRefused("no_rsus", [](ros::NodeHandle& n) {
     n.setParam("expected_rsus", std::vector<std::string>{});

@@ -90,7 +90,7 @@ void RsuNode::loadInitialModel() {
 
 void RsuNode::waitForPeers() {
   // I2I messages sent before a peer's connection exists are lost; the bridge starts once
-  // every RSU registered, so connect to every peer first (up to register_timeout).
+  // every RSU registered, so connect to every peer first (up to register_timeout_s).
   const int zones = static_cast<int>(options_.zones_m.size()) - 1;
   if (!options_.i2i || options_.whole_road || zones < 2) return;
   const uint32_t peers = static_cast<uint32_t>(zones - 1);

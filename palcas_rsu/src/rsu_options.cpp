@@ -64,11 +64,11 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
       p.integer("checkpoint_every_decisions", o.checkpoint_every_decisions, 0, std::numeric_limits<int>::max());
   o.federation = p.get<bool>("federation", o.federation);
   if (!o.federation) c.federation_interval_steps = 0;  // never due
-  o.federation_wait_s = p.number("federation_wait", o.federation_wait_s, 0.0, 3600.0);
-  o.federation_heartbeat_s = p.number("federation_heartbeat", o.federation_heartbeat_s, 0.0, 1e6);
+  o.federation_wait_s = p.number("federation_wait_s", o.federation_wait_s, 0.0, 3600.0);
+  o.federation_heartbeat_s = p.number("federation_heartbeat_s", o.federation_heartbeat_s, 0.0, 1e6);
   o.i2i = p.get<bool>("i2i", o.i2i);
-  o.i2i_stale_after_s = p.number("i2i_stale_after", o.i2i_stale_after_s, 1e-3, 1e9);
-  o.register_timeout_s = p.number("register_timeout", o.register_timeout_s, 0.0, 3600.0);
+  o.i2i_stale_after_s = p.number("i2i_stale_after_s", o.i2i_stale_after_s, 1e-3, 1e9);
+  o.register_timeout_s = p.number("register_timeout_s", o.register_timeout_s, 0.0, 3600.0);
   p.rejectUnknownKeys("palcas_rsu/README.md");
   c.validate();
   return o;

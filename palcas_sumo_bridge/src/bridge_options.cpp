@@ -85,11 +85,11 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.cav_lane_change_mode =
       p.integer("cav_lane_change_mode", o.session.cav_lane_change_mode, 0, 4095);
   o.session.lane_change_duration_s =
-      p.number("lane_change_duration", o.session.lane_change_duration_s, 0.1, 60.0);
+      p.number("lane_change_duration_s", o.session.lane_change_duration_s, 0.1, 60.0);
   o.session.own_car_following = p.get<bool>("own_car_following", o.session.own_car_following);
   o.session.own_merge = p.get<bool>("own_merge", o.session.own_merge);
   o.session.max_advised_accel_mps2 =
-      p.number("max_advised_accel", o.session.max_advised_accel_mps2, 0.0, 20.0);
+      p.number("max_advised_accel_mps2", o.session.max_advised_accel_mps2, 0.0, 20.0);
   o.session.remove_collided = p.get<bool>("remove_collided", o.session.remove_collided);
   o.session.cav_max_accel_mps2 = p.number("cav_max_accel_mps2", o.session.cav_max_accel_mps2, 0.0, 20.0);
   o.session.cav_max_decel_mps2 = p.number("cav_max_decel_mps2", o.session.cav_max_decel_mps2, 0.0, 20.0);
@@ -97,8 +97,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
       p.get<bool>("comfortable_lane_changes", o.session.comfortable_lane_changes);
   o.session.cluster_length_m = o.scenario.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
-  o.lockstep_deadline_s = p.number("lockstep_deadline", o.lockstep_deadline_s, 0.001, 60.0);
-  o.startup_timeout_s = p.number("startup_timeout", o.startup_timeout_s, 0.0, 3600.0);
+  o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);
+  o.startup_timeout_s = p.number("startup_timeout_s", o.startup_timeout_s, 0.0, 3600.0);
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.integer("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.integer("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
@@ -108,16 +108,16 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
       p.integer("trajectory_period_steps", o.trajectory_period_steps, 0, 1000000);
   o.advisory_hold_steps = p.integer("advisory_hold_steps", o.advisory_hold_steps, 1, 1000000);
   o.real_time_factor = p.number("real_time_factor", o.real_time_factor, 0.0, 1000.0);
-  o.metrics_period_s = p.number("metrics_period", o.metrics_period_s, 0.1, 1e6);
-  o.linger_s = p.number("linger", o.linger_s, 0.0, 60.0);
+  o.metrics_period_s = p.number("metrics_period_s", o.metrics_period_s, 0.1, 1e6);
+  o.linger_s = p.number("linger_s", o.linger_s, 0.0, 60.0);
   o.markers_every_steps = p.integer("markers_every_steps", o.markers_every_steps, 1, 1000000);
   o.publish_tf = p.get<bool>("publish_tf", o.publish_tf);
   o.rviz_template = p.get<std::string>("rviz_template", o.rviz_template);
   if (o.rviz_template == "none") o.rviz_template.clear();  // the launch files' "not set"
-  o.exit_miss_margin_m = p.number("exit_miss_margin", o.exit_miss_margin_m, 0.0, 1000.0);
-  o.merge_stop_speed_mps = p.number("merge_stop_speed", o.merge_stop_speed_mps, 0.0, 10.0);
-  o.merge_stop_window_m = p.number("merge_stop_window", o.merge_stop_window_m, 0.0, 1000.0);
-  o.comfort_threshold_mps2 = p.number("comfort_threshold", o.comfort_threshold_mps2, 0.0, 20.0);
+  o.exit_miss_margin_m = p.number("exit_miss_margin_m", o.exit_miss_margin_m, 0.0, 1000.0);
+  o.merge_stop_speed_mps = p.number("merge_stop_speed_mps", o.merge_stop_speed_mps, 0.0, 10.0);
+  o.merge_stop_window_m = p.number("merge_stop_window_m", o.merge_stop_window_m, 0.0, 1000.0);
+  o.comfort_threshold_mps2 = p.number("comfort_threshold_mps2", o.comfort_threshold_mps2, 0.0, 20.0);
   p.rejectUnknownKeys("palcas_sumo_bridge/README.md");
   return o;
 }

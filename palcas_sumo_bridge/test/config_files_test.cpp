@@ -67,7 +67,7 @@ TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
     loadBridgeOptions(ros::NodeHandle("~wrong_type"));
     FAIL() << "a string deadline was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("lockstep_deadline"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lockstep_deadline_s"), std::string::npos) << e.what();
   }
   try {
     loadBridgeOptions(ros::NodeHandle("~out_of_range"));

@@ -156,7 +156,7 @@ class AdvisoryTest(unittest.TestCase):
         speeds = [self.vehicle_in(s, target).speed_mps for s in states if self.vehicle_in(s, target)]
         self.assertGreaterEqual(len(speeds), 12, "the CAV left the road during the test")
         # From the first applied step, 10 steps (1.0 s) at the commanded acceleration, clipped
-        # to the comfort band (config/bridge.yaml max_advised_accel 1.47): about -1.47 m/s.
+        # to the comfort band (config/bridge.yaml max_advised_accel_mps2 1.47): about -1.47 m/s.
         executed = max(accel, -1.47)
         drop = speeds[11] - speeds[1]
         self.assertAlmostEqual(drop, executed * 1.0, delta=0.3,
@@ -218,7 +218,7 @@ class AdvisoryTest(unittest.TestCase):
         self.assertTrue(any("3.1" in d for d in details), details)
         # Exactly one rejection each: the duplicate's first KEEP was applied.
         self.assertEqual(len([g for g in got if g[0] == others[3].id]), 1)
-        # The episode metrics count them (metrics_period is short in this test).
+        # The episode metrics count them (metrics_period_s is short in this test).
         self.wait_until(lambda: self.metrics is not None and self.metrics.advisories_rejected >= 8,
                         "EpisodeMetrics.advisories_rejected >= 8")
 

@@ -79,7 +79,7 @@ class LockstepTest(unittest.TestCase):
         self.assertLess(silent, 2.0 * self.deadline_s, "the bridge waited past the deadline")
         # Answering again at once: the pace recovers (the RSU is still live).
         self.assertLess(fast, 0.5 * self.deadline_s)
-        # Late steps were counted (metrics_period is one step here).
+        # Late steps were counted (metrics_period_s is one step here).
         end = time.monotonic() + 10.0
         while time.monotonic() < end and (self.late_steps() or 0) < late_before + 10:
             time.sleep(0.05)

@@ -14,7 +14,7 @@
 namespace palcas::fedserver {
 
 struct FedServerOptions {
-  FederationOptions federation;  ///< expected_rsus, quorum, round_deadline, liveness_timeout, max_samples
+  FederationOptions federation;  ///< expected_rsus, quorum, round_deadline_s, liveness_timeout_s, max_samples
   /// ~learning/*: builds the initial global model (PdqnAgent(learning).exportModel()).
   PdqnConfig learning;
   std::string checkpoint_dir;            ///< "" = no checkpoints
