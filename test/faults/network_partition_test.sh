@@ -53,7 +53,7 @@ result link_made "$why"
 export PATH="/usr/bin:$PATH"
 port="$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("0.0.0.0",0)); print(s.getsockname()[1])')"
 export ROS_MASTER_URI="http://$HERE_IP:$port" ROS_LOG_DIR="$WORK/ros_log"
-printf 'lockstep_deadline_s: 0.2\nlost_after_missed_steps: 20\nstartup_timeout: 60.0\nmetrics_period: 1.0\n' >"$WORK/bridge.yaml"
+printf 'lockstep_deadline_s: 0.2\nlost_after_missed_steps: 20\nstartup_timeout_s: 60.0\nmetrics_period_s: 1.0\n' >"$WORK/bridge.yaml"
 ROS_IP="$HERE_IP" roslaunch -p "$port" palcas_launch bridge.launch scenario:=tiny duration:=600 \
   out_dir:="$WORK/run" advisory_control:=true expected_rsus:="[rsu_0]" real_time_factor:=5 \
   extra_params:="$WORK/bridge.yaml" >"$WORK/bridge.log" 2>&1 &
