@@ -3,7 +3,10 @@
 // namespace and change one thing.
 #include <gtest/gtest.h>
 #include <palcas_common/param_defaults.h>
+#include <palcas_common/param_test_cases.h>
 #include <ros/ros.h>
+
+#include <functional>
 
 #include "palcas_fedserver/fedserver_options.h"
 
@@ -11,26 +14,14 @@ using palcas::fedserver::loadFedServerOptions;
 
 namespace {
 
-// A copy of ~shipped under ~<name>, with `change` applied to it.
-ros::NodeHandle caseFrom(const std::string& name, void (*change)(ros::NodeHandle&)) {
-  ros::NodeHandle shipped("~shipped"), nh("~" + name);
-  XmlRpc::XmlRpcValue all;
-  EXPECT_TRUE(shipped.getParam("", all));
-  nh.deleteParam("");
-  nh.setParam("", all);
-  change(nh);
-  return nh;
+ros::NodeHandle caseFrom(const std::string& name, const std::function<void(ros::NodeHandle&)>& change) {
+  return palcas::common::paramCase("~shipped", name, change);
 }
 
-void expectRefused(const std::string& name, void (*change)(ros::NodeHandle&),
+void expectRefused(const std::string& name, const std::function<void(ros::NodeHandle&)>& change,
                    const std::string& needle) {
-  const ros::NodeHandle nh = caseFrom(name, change);
-  try {
-    loadFedServerOptions(nh);
-    ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas::common::expectLoadRefused([](const ros::NodeHandle& nh) { loadFedServerOptions(nh); }, "~shipped", name, change,
+                                    needle);
 }
 
 }  // namespace

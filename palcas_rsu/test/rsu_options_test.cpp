@@ -3,6 +3,7 @@
 // ~shipped into their own namespace and change one thing.
 #include <gtest/gtest.h>
 #include <palcas_common/param_defaults.h>
+#include <palcas_common/param_test_cases.h>
 #include <ros/ros.h>
 
 #include <cmath>
@@ -15,24 +16,13 @@ using palcas::rsu::loadRsuNodeOptions;
 namespace {
 
 ros::NodeHandle caseFrom(const std::string& name, const std::function<void(ros::NodeHandle&)>& change) {
-  ros::NodeHandle shipped("~shipped"), nh("~" + name);
-  XmlRpc::XmlRpcValue all;
-  EXPECT_TRUE(shipped.getParam("", all));
-  nh.deleteParam("");
-  nh.setParam("", all);
-  change(nh);
-  return nh;
+  return palcas::common::paramCase("~shipped", name, change);
 }
 
 void expectRefused(const std::string& name, const std::function<void(ros::NodeHandle&)>& change,
                    const std::string& needle) {
-  const ros::NodeHandle nh = caseFrom(name, change);
-  try {
-    loadRsuNodeOptions(nh);
-    ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas::common::expectLoadRefused([](const ros::NodeHandle& nh) { loadRsuNodeOptions(nh); }, "~shipped", name, change,
+                                    needle);
 }
 
 }  // namespace
