@@ -115,6 +115,12 @@ void RsuNode::registerWithBridge() {
              options_.register_timeout_s);
     return;
   }
+  // The bridge published its road before opening registration: refuse a zone or lane
+  // count that is not on it, naming both (the node ends; its supervisor reports it).
+  std::vector<double> road_zones;
+  int road_lanes = 0;
+  if (nh_.getParam(ROAD_ZONES_PARAM, road_zones) && nh_.getParam(ROAD_LANES_PARAM, road_lanes))
+    checkAgainstRoad(options_, road_zones, road_lanes);
   // Registering starts the bridge's step 0: make sure its states reach us first.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
   while (ros::ok() && states_sub_.getNumPublishers() == 0 && ros::WallTime::now() < deadline)

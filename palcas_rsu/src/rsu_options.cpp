@@ -2,6 +2,8 @@
 
 #include <palcas_common/param_reader.h>
 
+#include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "palcas_common/core_params.h"
@@ -72,6 +74,33 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   p.rejectUnknownKeys("palcas_rsu/README.md");
   c.validate();
   return o;
+}
+
+void checkAgainstRoad(const RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes) {
+  const RsuControllerOptions& c = o.controller;
+  if (road_lanes != c.num_lanes)
+    throw std::invalid_argument("the bridge's road has " + std::to_string(road_lanes) +
+                                " lanes but rsu/num_lanes is " + std::to_string(c.num_lanes) +
+                                " (the state size depends on it)");
+  if (road_zones_m.size() < 2) return;  // nothing to compare with
+  const int zones = static_cast<int>(road_zones_m.size()) - 1;
+  double start = road_zones_m.front(), end = road_zones_m.back();
+  std::string which = "the bridge's road spans";
+  if (!o.whole_road) {
+    if (c.cluster_index >= zones)
+      throw std::invalid_argument("rsu/cluster_index is " + std::to_string(c.cluster_index) +
+                                  " but the bridge's road has " + std::to_string(zones) + " zone(s)");
+    start = road_zones_m[c.cluster_index];
+    end = road_zones_m[c.cluster_index + 1];
+    which = "zone " + std::to_string(c.cluster_index) + " of the bridge's road is";
+  }
+  constexpr double TOLERANCE_M = 0.5;  // netconvert places edge ends to the centimetre
+  if (std::abs(start - c.x_start_m) > TOLERANCE_M || std::abs(end - c.x_end_m) > TOLERANCE_M) {
+    char text[256];
+    std::snprintf(text, sizeof text, "this RSU's zone is [%.1f, %.1f) m but %s [%.1f, %.1f) m",
+                  c.x_start_m, c.x_end_m, which.c_str(), start, end);
+    throw std::invalid_argument(text);
+  }
 }
 
 }  // namespace palcas::rsu

@@ -49,6 +49,7 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   advertise();
   advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
                                   ros::TransportHints().tcpNoDelay());
+  publishRoad();  // before registration opens: an RSU checks its zone when it registers
   register_srv_ = nh_.advertiseService(REGISTER_RSU_SERVICE, &BridgeNode::onRegister, this);
   ROS_INFO("palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
            session_->sumoVersion().c_str(), sim::SumoSession::apiName(), sumocfg_path_.c_str(),
@@ -59,6 +60,16 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   else if (!options_.expected_rsus.empty() || options_.session.advisory_control)
     ROS_WARN("palcas bridge: ~auth_key_file not set: advisories are NOT authenticated, any "
              "publisher on %s can steer CAVs", ADVISORIES_TOPIC);
+}
+
+void BridgeNode::publishRoad() {
+  std::vector<double> zones;
+  for (const sim::ClusterInfo& c : session_->road().clusters()) {
+    if (zones.empty()) zones.push_back(c.x_start_m);
+    zones.push_back(c.x_end_m);
+  }
+  nh_.setParam(ROAD_ZONES_PARAM, zones);
+  nh_.setParam(ROAD_LANES_PARAM, session_->road().numMainLanes());
 }
 
 void BridgeNode::advertise() {

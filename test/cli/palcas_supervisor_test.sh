@@ -23,6 +23,20 @@ elif ! grep -q "run without it" "$WORK/train/aborted_episodes.txt" 2>/dev/null; 
 fi
 result train_fails_when_an_rsu_dies "$why"
 
+# RSU zones that are not the bridge's road (tiny: [0, 300, 600]): the RSUs refuse at start,
+# naming both, and the training fails instead of running zones without CAVs.
+printf 'zones_m: [0.0, 250.0, 600.0]\n' >"$WORK/bad_zones.yaml"
+status=0
+PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 20 \
+  --rsu-params "$WORK/bad_zones.yaml" --out "$WORK/train_zones" >"$WORK/zones_out.log" 2>"$WORK/zones_err.log" || status=$?
+why=""
+if [ "$status" -eq 0 ]; then why="exit 0 although the RSUs' zones are not on the road"
+elif ! grep -q "error: training lost node(s) rsu_" "$WORK/zones_err.log"; then why="no line naming the RSUs: $(cat "$WORK/zones_err.log")"
+elif ! grep -q "this RSU's zone is \[.*) m but zone [01] of the bridge's road is \[" "$WORK/zones_err.log"; then
+  why="the error does not name both zones: $(cat "$WORK/zones_err.log")"
+fi
+result train_refuses_zones_not_on_the_road "$why"
+
 # SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
 # process it started and says so; a training's nodes checkpoint on the way out.
 left_of() {  # DIR: processes whose command line names DIR

@@ -43,4 +43,10 @@ struct RsuNodeOptions {
 RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh,
                                   common::ParamDefaults* defaults = nullptr);
 
+/// Checks this RSU's zone and lane count against the bridge's road (zone boundaries along
+/// the mainline and lane count, as the bridge publishes them). A centralized RSU (whole_road)
+/// must span the whole road. @throws std::invalid_argument naming both values on a mismatch
+/// (an RSU whose zone is not on the road would get no CAVs and nothing would say why).
+void checkAgainstRoad(const RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes);
+
 }  // namespace palcas::rsu

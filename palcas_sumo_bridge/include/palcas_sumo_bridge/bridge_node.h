@@ -41,6 +41,8 @@ class BridgeNode {
 
  private:
   void advertise();
+  /// ROAD_ZONES_PARAM and ROAD_LANES_PARAM: this road's zones and lanes for the RSUs' check.
+  void publishRoad();
   /// Start handshake: every expected RSU registered and ~min_subscribers listening, or
   /// the startup timeout. @return false when some RSU did not register.
   bool waitForPeers();
