@@ -56,19 +56,17 @@ class EvalDeterminismTest(unittest.TestCase):
             self.assertTrue(os.path.exists(out + "/episode.bag"), result.stdout[-3000:])
             runs.append(decisions(out + "/episode.bag"))
         a, b = runs
-        # rosbag record connects to each RSU's /advisories on its own schedule (the bridge
-        # only waits for it on its own topics), so under load a bag can miss an RSU's first
-        # decisions: compare from the first step every RSU is in both bags, and the full
-        # counts from metrics.json.
-        rsus = {r for _, r in list(a) + list(b)}
-        first = max(min(step for step, r in run if r == rsu) for run in (a, b) for rsu in rsus)
-        a = {k: v for k, v in a.items() if k[0] >= first}
-        b = {k: v for k, v in b.items() if k[0] >= first}
-        self.assertGreater(len(a), 50, "too few decisions to compare (from step %d)" % first)
-        self.assertEqual(sorted(a), sorted(b), "the runs decided at different steps / RSUs")
+        # rosbag record subscribes with a queue of 100 messages: under load it can join late or
+        # drop a stretch of /advisories (seen in CI: steps 680-840 missing from one bag while
+        # both runs counted the same decisions). A gap in a bag is not a difference between
+        # the runs, so compare every (step, RSU) both bags hold, and the full decision counts
+        # from metrics.json, which the bridge writes itself.
         counts = [json.load(open(out + "/metrics.json"))["decisions"] for out in outs]
         self.assertEqual(counts[0], counts[1], "the runs made different numbers of decisions")
-        differing = [k for k in a if a[k] != b[k]]
+        common = sorted(set(a) & set(b))
+        self.assertGreater(len(common), max(50, counts[0] // 4),
+                           "too few decisions in both bags to compare (%d of %d)" % (len(common), counts[0]))
+        differing = [k for k in common if a[k] != b[k]]
         self.assertFalse(differing[:5], "different advisories at (step, rsu) %s" % differing[:5])
 
 
