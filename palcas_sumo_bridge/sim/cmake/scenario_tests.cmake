@@ -1,5 +1,7 @@
-# scenario tests: network vs sources, demand writer, and an in-process SUMO smoke run per
-# scenario (libsumo holds one simulation per process, hence one executable per scenario).
+# scenario tests: road spec (checks, sources), network vs sources (generated and hand-written),
+# demand writer, and an in-process SUMO smoke run per scenario (libsumo holds one simulation
+# per process, hence one executable per scenario).
+palcas_sim_add_gtest(road_spec_test test/road_spec_test.cpp)
 palcas_sim_add_gtest(scenario_network_test test/scenario_network_test.cpp)
 palcas_sim_add_gtest(scenario_demand_test test/scenario_demand_test.cpp)
 foreach(scenario tiny paper)

@@ -1,5 +1,6 @@
 #pragma once
-// Helpers shared by the scenario tests: a fresh temporary folder per test and file reading.
+// Helpers shared by the scenario tests: a fresh temporary folder per test, the scenario and
+// test-data folders, the tiny road and file reading.
 
 #include <unistd.h>
 
@@ -7,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "palcas_sim/road_spec.h"
 
 namespace palcas::sim::test {
 
@@ -19,8 +22,28 @@ inline std::string freshDir(const std::string& name) {
   return dir.string();
 }
 
+/// config/scenarios/<name>: the tests read only its vtypes.xml.
 inline std::string scenarioDir(const std::string& name) {
   return std::string(PALCAS_CONFIG_DIR) + "/scenarios/" + name;
+}
+
+/// sim/test/data/hand_written_<name>: the former hand-written network sources (paper, tiny).
+inline std::string handWrittenDir(const std::string& name) {
+  return std::string(PALCAS_SIM_TEST_DATA_DIR) + "/hand_written_" + name;
+}
+
+/// The tiny road (config/scenarios/README.md): 2 clusters x 300 m, 3 lanes; warm-up 40 m, on-ramp
+/// joins at +60, 100 m acceleration lane, exit at +240; widths and speeds as the paper's.
+inline RoadSpec tinyRoad() {
+  RoadSpec r;
+  r.clusters = 2;
+  r.num_lanes = 3;
+  r.cluster_length_m = 300.0;
+  r.warmup_length_m = 40.0;
+  r.merge_start_m = 60.0;
+  r.acceleration_lane_m = 100.0;
+  r.exit_m = 240.0;
+  return r;
 }
 
 inline std::string slurp(const std::string& path) {
