@@ -3,15 +3,25 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "palcas_sim/scenario.h"
+#include "road_checks.h"
 
 namespace palcas::sim {
 namespace {
 
 constexpr double SHARE_SUM_TOLERANCE = 1e-6;
 constexpr double X_TOLERANCE_M = 0.01;  // netconvert writes coordinates with 2 decimals
+
+/// A number for messages (10 significant digits).
+std::string num(double v) {
+  std::ostringstream out;
+  out.precision(10);
+  out << v;
+  return out.str();
+}
 
 void requireFinite(double v, const std::string& field) {
   if (!std::isfinite(v))
@@ -73,10 +83,11 @@ void validateSpeed(const TwoPointSpeed& s, const std::string& field) {
 }
 
 /// Shares of `source` checked against its allowed destinations; returns them.
-const RouteShares& checkedShares(const ScenarioConfig& config, const std::string& source,
+const RouteShares& checkedShares(const std::map<std::string, RouteShares>& route_shares,
+                                 const std::string& source,
                                  const std::vector<std::string>& destinations) {
-  const auto it = config.route_shares.find(source);
-  if (it == config.route_shares.end())
+  const auto it = route_shares.find(source);
+  if (it == route_shares.end())
     throw std::invalid_argument("ScenarioConfig.route_shares has no entry for source '" + source + "'");
   double sum = 0.0;
   for (const auto& [to, share] : it->second) {
@@ -147,7 +158,12 @@ std::map<std::string, RouteShares> defaultRouteShares(int num_clusters) {
 
 void validateScenarioConfig(const ScenarioConfig& c) {
   if (c.scenario_dir.empty()) throw std::invalid_argument("ScenarioConfig.scenario_dir is empty");
-  requirePositive(c.cluster_length_m, "cluster_length_m");
+  if (c.generate_network) {
+    validateRoadSpec(c.road);
+  } else {  // a hand-written network: only what describes any road of the naming convention
+    detail::validateRoadZones(c.road);
+    detail::validateRoadLanes(c.road);
+  }
   requireInRange(c.penetration_rate, 0.0, 1.0, "penetration_rate");
   requirePositive(c.duration_s, "duration_s");
   requireInRange(c.mainline_flow_vphpl, 0.0, 1e6, "mainline_flow_vphpl");
@@ -180,12 +196,25 @@ std::vector<RouteDemand> buildRoutes(const ScenarioConfig& c, const std::vector<
       lanes = e.lane_count;
       break;
     }
-  const RoadLayout road(edges, std::max(lanes, 1), c.cluster_length_m);
+  const RoadLayout road(edges, std::max(lanes, 1), c.road.cluster_length_m);
   const std::vector<EdgeInfo> main = orderedMainline(road, edges);
+  // The network must be the road the config describes (RSUs get their zones from c.road).
+  if (lanes != c.road.num_lanes)
+    throw std::invalid_argument("network has " + std::to_string(lanes) +
+                                " mainline lanes but road/num_lanes is " +
+                                std::to_string(c.road.num_lanes));
+  if (static_cast<int>(road.clusters().size()) != c.road.clusters)
+    throw std::invalid_argument("network has " + std::to_string(road.clusters().size()) +
+                                " clusters of road/cluster_length_m " +
+                                num(c.road.cluster_length_m) + " m (mainline " +
+                                num(road.mainlineLengthM()) + " m) but road/clusters is " +
+                                std::to_string(c.road.clusters));
+  const std::map<std::string, RouteShares> route_shares =
+      c.route_shares.empty() ? defaultRouteShares(c.road.clusters) : c.route_shares;
   std::vector<std::string> known_sources{"main"};
   for (const ClusterInfo& k : road.clusters())
     if (!k.on_ramp_edge.empty()) known_sources.push_back("on" + std::to_string(k.index));
-  for (const auto& entry : c.route_shares)
+  for (const auto& entry : route_shares)
     if (std::find(known_sources.begin(), known_sources.end(), entry.first) == known_sources.end())
       throw std::invalid_argument("ScenarioConfig.route_shares: unknown source '" + entry.first + "'");
 
@@ -196,7 +225,7 @@ std::vector<RouteDemand> buildRoutes(const ScenarioConfig& c, const std::vector<
     std::vector<std::string> destinations{"end"};
     for (const ClusterInfo& k : road.clusters())
       if (!k.off_ramp_edge.empty() && k.index >= first_exit) destinations.push_back("off" + std::to_string(k.index));
-    const RouteShares& shares = checkedShares(c, from, destinations);
+    const RouteShares& shares = checkedShares(route_shares, from, destinations);
     for (const std::string& to : destinations) {
       RouteDemand r;
       r.id = "r_" + from + "_" + to;

@@ -1,5 +1,6 @@
-// Network half of the scenario: netconvert on the plain XML sources, and reading the
-// generated .net.xml back (edges with their x range, lane connections).
+// Network half of the scenario: netconvert on the plain XML sources (hand-written or generated
+// from a RoadSpec), and reading the generated .net.xml back (edges with their x range, lane
+// connections).
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -96,6 +97,13 @@ std::string generateNetwork(const std::string& scenario_dir, const std::string& 
     throw std::runtime_error("netconvert failed (status " + std::to_string(status) +
                              ") on scenario '" + scenario_dir + "':\n" + output);
   return net_file;
+}
+
+std::string generateNetwork(const RoadSpec& road, const std::string& out_dir,
+                            const std::string& netconvert_binary) {
+  const std::string sources = (fs::path(out_dir) / "sources").string();
+  writeNetworkSources(road, sources);
+  return generateNetwork(sources, out_dir, netconvert_binary);
 }
 
 std::vector<EdgeInfo> readNetEdges(const std::string& net_file) {

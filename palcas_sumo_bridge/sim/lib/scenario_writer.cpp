@@ -132,7 +132,9 @@ ScenarioFiles writeScenario(const ScenarioConfig& config, const std::string& out
                                 "' is not a folder");
   const auto templates = readVTypeTemplates(config.scenario_dir);
   ScenarioFiles files;
-  files.net_file = generateNetwork(config.scenario_dir, out_dir, config.netconvert_binary);
+  files.net_file = config.generate_network
+                       ? generateNetwork(config.road, out_dir, config.netconvert_binary)
+                       : generateNetwork(config.scenario_dir, out_dir, config.netconvert_binary);
   const std::vector<RouteDemand> routes = buildRoutes(config, readNetEdges(files.net_file));
   files.routes_file = (fs::path(out_dir) / "routes.rou.xml").string();
   files.sumocfg_file = (fs::path(out_dir) / "scenario.sumocfg").string();

@@ -13,11 +13,13 @@
 using palcas::sim::EdgeInfo;
 using palcas::sim::ScenarioConfig;
 using palcas::sim::test::freshDir;
+using palcas::sim::test::handWrittenDir;
 using palcas::sim::test::scenarioDir;
 using palcas::sim::test::slurp;
 
 namespace {
 
+/// The paper road generated from the default RoadSpec, vtypes.xml from config/scenarios/paper.
 ScenarioConfig paperConfig(double pr) {
   ScenarioConfig c;
   c.scenario_dir = scenarioDir("paper");
@@ -73,6 +75,7 @@ std::vector<EdgeInfo> twoClusterEdges() {
 ScenarioConfig twoClusterConfig() {
   ScenarioConfig c;
   c.scenario_dir = "unused-by-buildRoutes";
+  c.road.clusters = 2;
   c.route_shares = palcas::sim::defaultRouteShares(2);
   return c;
 }
@@ -196,6 +199,9 @@ TEST(ScenarioDemand, RejectsBadScalarsBeforeWritingAnything) {
   bad([](ScenarioConfig& c) { c.max_depart_delay_s = std::numeric_limits<double>::infinity(); },
       "max_depart_delay_s");
   bad([](ScenarioConfig& c) { c.scenario_dir = ""; }, "scenario_dir");
+  bad([](ScenarioConfig& c) { c.road.clusters = 0; }, "road/clusters");
+  bad([](ScenarioConfig& c) { c.road.exit_m = 900; }, "road/exit_m");
+  bad([](ScenarioConfig& c) { c.road.lane_width_m = 0; }, "road/lane_width_m");
   bad([](ScenarioConfig& c) { c.scenario_dir = "/nonexistent/scenario"; }, "/nonexistent/scenario");
 }
 
@@ -240,19 +246,73 @@ TEST(ScenarioDemand, BuildRoutesOnAHandMadeRoad) {
   auto gap = twoClusterEdges();
   gap[3].x_end_m = 690;  // main_0_mid now ends at 690, main_0_down starts at 700
   expectInvalid([&] { palcas::sim::buildRoutes(c, gap); }, "main_0_mid");
+  // The network must be the configured road: cluster and lane counts are compared.
+  c.road.clusters = 3;
+  expectInvalid([&] { palcas::sim::buildRoutes(c, twoClusterEdges()); }, "road/clusters is 3");
+  c.road.clusters = 2;
+  c.road.num_lanes = 4;
+  expectInvalid([&] { palcas::sim::buildRoutes(c, twoClusterEdges()); }, "road/num_lanes is 4");
+}
+
+TEST(ScenarioDemand, EmptyRouteSharesMeanTheDefaultForTheRoad) {
+  ScenarioConfig c = paperConfig(0.6);
+  ASSERT_TRUE(c.route_shares.empty());  // the default
+  c.road.clusters = 4;
+  c.road.num_lanes = 4;
+  c.mainline_flow_vphpl = 1000;
+  const auto files = palcas::sim::writeScenario(c, freshDir("default_shares"));
+  const auto f = flows(slurp(files.routes_file));
+  // main: end + 4 exits; on0: end + off1..3; on1: 3; on2: 2; on3: end only.
+  EXPECT_EQ(f.size(), 15u);
+  EXPECT_NEAR(f.at("r_main_end"), 2200.0, 1e-6);    // 1000 x 4 lanes x 0.55
+  EXPECT_NEAR(f.at("r_main_off3"), 450.0, 1e-6);    // 4000 x 0.45 / 4
+  EXPECT_NEAR(f.at("r_on0_off3"), 120.0, 1e-6);     // 600 x 0.6 / 3
+  EXPECT_NEAR(f.at("r_on3_end"), 600.0, 1e-6);      // the last ramp: all to the end
+  // buildRoutes applies the same default.
+  const auto routes = palcas::sim::buildRoutes(c, palcas::sim::readNetEdges(files.net_file));
+  ASSERT_EQ(routes.size(), 15u);
+  EXPECT_EQ(routes.back().id, "r_on3_end");
+  EXPECT_EQ(routes.back().edges, (std::vector<std::string>{"on_3", "main_3_merge", "main_3_mid",
+                                                          "main_3_down"}));
+}
+
+TEST(ScenarioDemand, HandWrittenNetworkWhenGenerationIsOff) {
+  // A folder with the hand-written tiny sources and the tiny vehicle types.
+  const std::string dir = freshDir("hand_written");
+  for (const char* f : {"network.nod.xml", "network.edg.xml", "network.con.xml"})
+    std::filesystem::copy_file(handWrittenDir("tiny") + "/" + f, dir + "/" + f);
+  std::filesystem::copy_file(scenarioDir("tiny") + "/vtypes.xml", dir + "/vtypes.xml");
+  ScenarioConfig c;
+  c.scenario_dir = dir;
+  c.generate_network = false;
+  c.road.clusters = 2;  // only the counts and the zone length describe a hand-written road ...
+  c.road.num_lanes = 3;
+  c.road.cluster_length_m = 300;
+  c.road.exit_m = 1e9;  // ... the rest is not read
+  const auto files = palcas::sim::writeScenario(c, dir + "/out");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/sources"));
+  const auto f = flows(slurp(files.routes_file));
+  EXPECT_NEAR(f.at("r_on1_end"), 600.0, 1e-6);  // defaultRouteShares(2)
+  EXPECT_EQ(f.size(), 6u);
+  c.road.clusters = 3;  // not this network
+  expectInvalid([&] { palcas::sim::writeScenario(c, dir + "/out3"); }, "road/clusters");
+  c.road.clusters = 2;
+  c.road.num_lanes = 0;
+  expectInvalid([&] { palcas::sim::writeScenario(c, dir + "/out0"); }, "road/num_lanes");
+  c.road.num_lanes = 3;
+  c.scenario_dir = scenarioDir("tiny") + "/no_such_folder";
+  expectInvalid([&] { palcas::sim::writeScenario(c, dir + "/out_missing"); }, "no_such_folder");
 }
 
 TEST(ScenarioDemand, RejectsVTypeTemplateThatSetsMaxSpeed) {
   const std::string dir = freshDir("bad_vtypes");
-  for (const char* f : {"network.nod.xml", "network.edg.xml", "network.con.xml", "vtypes.xml"})
-    std::filesystem::copy_file(scenarioDir("tiny") + "/" + f, dir + "/" + f);
+  std::filesystem::copy_file(scenarioDir("tiny") + "/vtypes.xml", dir + "/vtypes.xml");
   std::string vtypes = slurp(dir + "/vtypes.xml");
   vtypes.replace(vtypes.find("<vType id=\"cav\""), 15, "<vType id=\"cav\" maxSpeed=\"50\"");
   std::ofstream(dir + "/vtypes.xml") << vtypes;
   ScenarioConfig c;
   c.scenario_dir = dir;
-  c.cluster_length_m = 300;
-  c.route_shares = palcas::sim::defaultRouteShares(2);
+  c.road = palcas::sim::test::tinyRoad();
   expectInvalid([&] { palcas::sim::writeScenario(c, dir + "/out"); }, "maxSpeed");
   std::filesystem::remove(dir + "/vtypes.xml");
   expectInvalid([&] { palcas::sim::writeScenario(c, dir + "/out"); }, "vtypes.xml");

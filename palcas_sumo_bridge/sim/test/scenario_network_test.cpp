@@ -1,4 +1,6 @@
-// The generated networks match their plain XML sources (config/scenarios/{paper,tiny}).
+// The networks generated from RoadSpecs: where their edges sit, how their lanes connect, and
+// that the paper and tiny specs give the networks of the former hand-written sources
+// (test/data/hand_written_{paper,tiny}).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,8 +16,11 @@
 using palcas::sim::EdgeInfo;
 using palcas::sim::LaneConnection;
 using palcas::sim::RoadLayout;
+using palcas::sim::RoadSpec;
 using palcas::sim::test::freshDir;
+using palcas::sim::test::handWrittenDir;
 using palcas::sim::test::scenarioDir;
+using palcas::sim::test::tinyRoad;
 
 namespace {
 
@@ -64,10 +69,89 @@ void expectEdges(const std::map<std::string, EdgeInfo>& edges, const std::vector
   }
 }
 
+/// The same network: the same non-internal edges (ids, lane counts, lane 0's x range within
+/// 0.01 m) and the same lane connections.
+void expectSameNetwork(const std::string& got_net, const std::string& want_net) {
+  const auto got = byId(palcas::sim::readNetEdges(got_net));
+  const auto want = byId(palcas::sim::readNetEdges(want_net));
+  EXPECT_EQ(got.size(), want.size());
+  for (const auto& [id, w] : want) {
+    ASSERT_EQ(got.count(id), 1u) << id;
+    EXPECT_EQ(got.at(id).lane_count, w.lane_count) << id;
+    EXPECT_NEAR(got.at(id).x_start_m, w.x_start_m, 0.01) << id;
+    EXPECT_NEAR(got.at(id).x_end_m, w.x_end_m, 0.01) << id;
+  }
+  EXPECT_EQ(links(palcas::sim::readNetConnections(got_net)),
+            links(palcas::sim::readNetConnections(want_net)));
+}
+
 }  // namespace
 
-TEST(ScenarioNetwork, PaperEdgesSitWhereTheSourcesPutThem) {
-  const std::string net = palcas::sim::generateNetwork(scenarioDir("paper"), freshDir("net_paper"));
+TEST(ScenarioNetwork, PaperSpecGivesTheHandWrittenPaperNetwork) {
+  expectSameNetwork(palcas::sim::generateNetwork(RoadSpec{}, freshDir("same_paper_gen")),
+                    palcas::sim::generateNetwork(handWrittenDir("paper"), freshDir("same_paper_hw")));
+}
+
+TEST(ScenarioNetwork, TinySpecGivesTheHandWrittenTinyNetwork) {
+  expectSameNetwork(palcas::sim::generateNetwork(tinyRoad(), freshDir("same_tiny_gen")),
+                    palcas::sim::generateNetwork(handWrittenDir("tiny"), freshDir("same_tiny_hw")));
+}
+
+TEST(ScenarioNetwork, SourcesAreWrittenBesideTheNetwork) {
+  const std::string out = freshDir("net_sources");
+  EXPECT_EQ(palcas::sim::generateNetwork(tinyRoad(), out), out + "/network.net.xml");
+  for (const char* f : {"network.nod.xml", "network.edg.xml", "network.con.xml"})
+    EXPECT_TRUE(std::filesystem::is_regular_file(out + "/sources/" + f)) << f;
+  RoadSpec bad = tinyRoad();
+  bad.exit_m = 300.0;  // at the cluster's end: no room for main_k_down
+  const std::string never = freshDir("net_sources_bad") + "/never";
+  EXPECT_THROW(palcas::sim::generateNetwork(bad, never), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(never));
+}
+
+TEST(ScenarioNetwork, FourClustersOfFourLanesFromASpec) {
+  RoadSpec spec;
+  spec.clusters = 4;
+  spec.num_lanes = 4;
+  spec.cluster_length_m = 500.0;
+  spec.warmup_length_m = 50.0;
+  spec.merge_start_m = 80.0;
+  spec.acceleration_lane_m = 150.0;
+  spec.exit_m = 400.0;
+  const std::string net = palcas::sim::generateNetwork(spec, freshDir("net_four"));
+  const auto edges = palcas::sim::readNetEdges(net);
+  EXPECT_EQ(edges.size(), 1u + 4u * 6u);  // warm-up + (up, merge, mid, down, on, off) per cluster
+  const RoadLayout road(edges, 4, 500.0);
+  EXPECT_EQ(road.numMainLanes(), 4);
+  EXPECT_DOUBLE_EQ(road.mainlineLengthM(), 2000.0);  // 4 clusters x 500 m
+  ASSERT_EQ(road.clusters().size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    const auto& c = road.clusters()[k];
+    const double b = 500.0 * k;
+    EXPECT_DOUBLE_EQ(c.x_start_m, b);
+    EXPECT_DOUBLE_EQ(c.x_end_m, b + 500.0);
+    EXPECT_EQ(c.on_ramp_edge, "on_" + std::to_string(k));
+    EXPECT_EQ(c.merge_edge, "main_" + std::to_string(k) + "_merge");
+    EXPECT_EQ(road.edge(c.merge_edge).lane_count, 5);  // 4 lanes + the acceleration lane
+    EXPECT_NEAR(c.accel_lane_x_start_m, b + 80.0, 0.01);
+    EXPECT_NEAR(c.accel_lane_length_m, 150.0, 0.01);
+    EXPECT_EQ(c.off_ramp_edge, "off_" + std::to_string(k));
+    EXPECT_NEAR(c.exit_x_m, b + 400.0, 0.01);
+    EXPECT_NEAR(road.edge("on_" + std::to_string(k)).x_start_m, b, 0.01);
+    EXPECT_NEAR(road.edge("off_" + std::to_string(k)).x_end_m, b + 500.0, 0.01);
+  }
+  EXPECT_NEAR(road.edge("main_0_warmup").x_end_m, 50.0, 0.01);
+  std::set<Link> expected;
+  for (int l = 0; l < 4; ++l) expected.insert({"main_0_warmup", l, "main_0_up", l});
+  for (int k = 0; k < 4; ++k) {
+    const std::set<Link> cluster = expectedClusterLinks(k, 4, k == 3);
+    expected.insert(cluster.begin(), cluster.end());
+  }
+  EXPECT_EQ(links(palcas::sim::readNetConnections(net)), expected);
+}
+
+TEST(ScenarioNetwork, PaperEdgesSitWhereTheSpecPutsThem) {
+  const std::string net = palcas::sim::generateNetwork(RoadSpec{}, freshDir("net_paper"));
   // Cluster k spans [800k, 800k + 800): up to 800k+150, merge to 800k+400, exit at 800k+700.
   expectEdges(byId(palcas::sim::readNetEdges(net)),
               {{"main_0_warmup", 0, 100, 5},   {"main_0_up", 100, 150, 5},
@@ -83,7 +167,7 @@ TEST(ScenarioNetwork, PaperEdgesSitWhereTheSourcesPutThem) {
 }
 
 TEST(ScenarioNetwork, PaperRoadLayoutHasThreeClustersWithRampsAndExits) {
-  const std::string net = palcas::sim::generateNetwork(scenarioDir("paper"), freshDir("layout_paper"));
+  const std::string net = palcas::sim::generateNetwork(RoadSpec{}, freshDir("layout_paper"));
   const RoadLayout road(palcas::sim::readNetEdges(net), 5, 800.0);
   EXPECT_DOUBLE_EQ(road.mainlineLengthM(), 2400.0);  // 3 clusters x 800 m
   ASSERT_EQ(road.clusters().size(), 3u);
@@ -105,8 +189,8 @@ TEST(ScenarioNetwork, PaperRoadLayoutHasThreeClustersWithRampsAndExits) {
   EXPECT_EQ(road.paperLane("main_1_mid", 0), 1);
 }
 
-TEST(ScenarioNetwork, PaperLanesConnectAsTheSourcesSay) {
-  const std::string net = palcas::sim::generateNetwork(scenarioDir("paper"), freshDir("links_paper"));
+TEST(ScenarioNetwork, PaperLanesConnectAsTheReadmeSays) {
+  const std::string net = palcas::sim::generateNetwork(RoadSpec{}, freshDir("links_paper"));
   std::set<Link> expected;
   for (int l = 0; l < 5; ++l) expected.insert({"main_0_warmup", l, "main_0_up", l});
   for (int k = 0; k < 3; ++k) {
@@ -119,7 +203,7 @@ TEST(ScenarioNetwork, PaperLanesConnectAsTheSourcesSay) {
 }
 
 TEST(ScenarioNetwork, TinyEdgesLayoutAndLinks) {
-  const std::string net = palcas::sim::generateNetwork(scenarioDir("tiny"), freshDir("net_tiny"));
+  const std::string net = palcas::sim::generateNetwork(tinyRoad(), freshDir("net_tiny"));
   const auto edges = palcas::sim::readNetEdges(net);
   // Cluster k spans [300k, 300k + 300): up to +60, merge to +160, exit at +240.
   expectEdges(byId(edges), {{"main_0_warmup", 0, 40, 3},   {"main_0_up", 40, 60, 3},
@@ -156,10 +240,10 @@ TEST(ScenarioNetwork, MissingSourcesAreRejectedByName) {
 }
 
 TEST(ScenarioNetwork, NetconvertFailureCarriesItsOutput) {
-  // A copy of the tiny sources whose edge names a node that does not exist.
+  // A copy of the hand-written tiny sources whose edge names a node that does not exist.
   const std::string broken = freshDir("broken_sources");
   for (const char* f : {"network.nod.xml", "network.edg.xml", "network.con.xml"})
-    std::filesystem::copy_file(scenarioDir("tiny") + "/" + f, broken + "/" + f);
+    std::filesystem::copy_file(handWrittenDir("tiny") + "/" + f, broken + "/" + f);
   std::string edges = palcas::sim::test::slurp(broken + "/network.edg.xml");
   edges.replace(edges.find("from=\"n_start\""), 14, "from=\"n_nowhere\"");
   std::ofstream(broken + "/network.edg.xml") << edges;
@@ -174,7 +258,7 @@ TEST(ScenarioNetwork, NetconvertFailureCarriesItsOutput) {
 }
 
 TEST(ScenarioNetwork, MissingNetconvertIsAClearError) {
-  EXPECT_THROW(palcas::sim::generateNetwork(scenarioDir("tiny"), freshDir("out_nobin"),
+  EXPECT_THROW(palcas::sim::generateNetwork(handWrittenDir("tiny"), freshDir("out_nobin"),
                                             "/nonexistent/netconvert"),
                std::runtime_error);
 }
@@ -182,7 +266,7 @@ TEST(ScenarioNetwork, MissingNetconvertIsAClearError) {
 TEST(ScenarioNetwork, ReadingSomethingThatIsNotANetworkFails) {
   EXPECT_THROW(palcas::sim::readNetEdges("/nonexistent/net.net.xml"), std::runtime_error);
   try {
-    palcas::sim::readNetEdges(scenarioDir("paper") + "/network.nod.xml");
+    palcas::sim::readNetEdges(handWrittenDir("paper") + "/network.nod.xml");
     FAIL() << "no exception";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not a SUMO network"), std::string::npos) << e.what();

@@ -27,10 +27,9 @@ palcas::sim::ScenarioConfig smokeConfig() {
   c.penetration_rate = PR;
   c.duration_s = RUN_S;
   if (name == "tiny") {  // config/scenarios/tiny/scenario.yaml
-    c.cluster_length_m = 300.0;
+    c.road = palcas::sim::test::tinyRoad();
     c.mainline_flow_vphpl = 1000.0;
     c.onramp_flow_vphpl = 300.0;
-    c.route_shares = palcas::sim::defaultRouteShares(2);
   }
   return c;
 }

@@ -24,8 +24,7 @@ constexpr int LANE_LEFT = 0, ACCELERATE = 2, KEEP = 3;
 SessionOptions tinyOptions() {
   palcas::sim::ScenarioConfig c;
   c.scenario_dir = palcas::sim::test::scenarioDir("tiny");
-  c.cluster_length_m = 300.0;
-  c.route_shares = palcas::sim::defaultRouteShares(2);  // the tiny road has two clusters
+  c.road = palcas::sim::test::tinyRoad();  // default route shares for its two clusters
   c.penetration_rate = 1.0;  // every vehicle a CAV: plenty of candidates
   c.duration_s = 400.0;
   c.seed = 3;

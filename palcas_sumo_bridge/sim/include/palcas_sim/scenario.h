@@ -1,14 +1,16 @@
 #pragma once
-// The paper's SUMO scenario (paper "Simulation Setup"): network generation
-// from the plain XML sources in config/scenarios/<name>/ with netconvert, the demand (vehicle
-// types, routes, flows) and the .sumocfg. Layout, naming and every parameter's reason:
-// config/scenarios/README.md; the defaults mirrored as YAML: config/scenarios/paper/scenario.yaml.
+// The paper's SUMO scenario (paper "Simulation Setup"): the network (netconvert on sources
+// generated from a RoadSpec, palcas_sim/road_spec.h, or on hand-written ones that follow the
+// naming), the demand (vehicle types, routes, flows) and the .sumocfg. Layout, naming and every
+// parameter's reason: config/scenarios/README.md; the defaults mirrored as YAML:
+// config/scenarios/paper/scenario.yaml.
 
 #include <map>
 #include <string>
 #include <vector>
 
 #include "palcas_sim/road_layout.h"
+#include "palcas_sim/road_spec.h"
 
 namespace palcas::sim {
 
@@ -41,14 +43,22 @@ std::map<std::string, RouteShares> defaultRouteShares(int num_clusters);
 /// Everything that defines one generated scenario. Defaults are the paper's where it gives a
 /// value; the others are documented choices (config/scenarios/README.md).
 struct ScenarioConfig {
-  std::string scenario_dir;          ///< folder with network.{nod,edg,con}.xml and vtypes.xml
-  double cluster_length_m = 800.0;   ///< RSU zone length (paper: 0.8 km)
+  /// Folder with vtypes.xml, and with network.{nod,edg,con}.xml when generate_network is false.
+  std::string scenario_dir;
+  /// The road (paper defaults). road.cluster_length_m is the RSU zone length given to RoadLayout;
+  /// road.clusters and road.num_lanes must be the network's (checked by buildRoutes).
+  RoadSpec road;
+  /// true: the network sources are generated from `road` into <out_dir>/sources/; false: the
+  /// hand-written <scenario_dir>/network.{nod,edg,con}.xml are used (only road.clusters,
+  /// road.num_lanes and road.cluster_length_m are then read).
+  bool generate_network = true;
   double penetration_rate = 0.6;     ///< CAV share PR in [0, 1] (paper default 60 %)
   unsigned int seed = 42;            ///< SUMO --seed (vehicle types, insertion, sigma)
   double duration_s = 3600.0;        ///< simulated time, SUMO --end (> 0)
   double mainline_flow_vphpl = 3200.0;  ///< veh/h per mainline lane (paper), >= 0
   double onramp_flow_vphpl = 600.0;     ///< veh/h per on-ramp lane (paper), >= 0
-  std::map<std::string, RouteShares> route_shares = defaultRouteShares(3);
+  /// Empty: defaultRouteShares(road.clusters).
+  std::map<std::string, RouteShares> route_shares;
   TwoPointSpeed cav_speed;           ///< CAV maximum speeds
   TwoPointSpeed hdv_speed;           ///< HDV (the paper's CHV) maximum speeds
   /// Mainline flows start on the 100 m warm-up edge at a random free place (paper: "randomly
@@ -91,18 +101,22 @@ struct VTypeProbabilities {
 /// True for the CAV vehicle types (their id starts with "cav").
 inline bool isCavType(const std::string& type_id) { return type_id.rfind("cav", 0) == 0; }
 
-/// Checks every scalar field and the insertion keywords (not the route shares, which need the
-/// network). @throws std::invalid_argument naming the field and the bad value.
+/// Checks every scalar field, the insertion keywords and the road (validateRoadSpec when
+/// generate_network, else road.clusters, road.num_lanes and road.cluster_length_m); not the
+/// route shares, which need the network. @throws std::invalid_argument naming the field and
+/// the bad value.
 void validateScenarioConfig(const ScenarioConfig& config);
 
 /// @throws std::invalid_argument as validateScenarioConfig.
 VTypeProbabilities vTypeProbabilities(const ScenarioConfig& config);
 
-/// Every route of the network with its flow (route shares checked against the network).
+/// Every route of the network with its flow (route shares checked against the network; empty
+/// route_shares = defaultRouteShares(road.clusters)).
 /// @param edges the network's edges (readNetEdges). @throws std::invalid_argument naming the
 ///        source or destination when a share is missing, unknown, negative, upstream of its
-///        source, or a source's shares do not sum to 1 (tolerance 1e-6); or when the mainline
-///        has a gap or lanes of differing count.
+///        source, or a source's shares do not sum to 1 (tolerance 1e-6); when the mainline
+///        has a gap or lanes of differing count; or when the network's cluster or lane count is
+///        not road.clusters / road.num_lanes.
 std::vector<RouteDemand> buildRoutes(const ScenarioConfig& config,
                                      const std::vector<EdgeInfo>& edges);
 
@@ -110,6 +124,12 @@ std::vector<RouteDemand> buildRoutes(const ScenarioConfig& config,
 /// (creating out_dir). @return the .net.xml path. @throws std::invalid_argument when a source
 /// file is missing; std::runtime_error with netconvert's output when it fails.
 std::string generateNetwork(const std::string& scenario_dir, const std::string& out_dir,
+                            const std::string& netconvert_binary = "netconvert");
+
+/// writeNetworkSources(road, <out_dir>/sources), then netconvert on them into
+/// <out_dir>/network.net.xml. @return the .net.xml path. @throws std::invalid_argument for a
+/// bad spec (nothing written); std::runtime_error as generateNetwork or writeNetworkSources.
+std::string generateNetwork(const RoadSpec& road, const std::string& out_dir,
                             const std::string& netconvert_binary = "netconvert");
 
 /// Non-internal edges of a SUMO .net.xml: id, lane count, x_start_m / x_end_m = x of the first
@@ -130,13 +150,15 @@ struct LaneConnection {
 /// @throws std::runtime_error as readNetEdges.
 std::vector<LaneConnection> readNetConnections(const std::string& net_file);
 
-/// Generates the whole scenario into out_dir: network.net.xml (netconvert), routes.rou.xml
-/// (vTypeDistribution "mixed" of cav_fast, cav_slow, hdv_fast, hdv_slow built from
+/// Generates the whole scenario into out_dir: network.net.xml (netconvert on the sources
+/// generated from config.road into out_dir/sources/, or on the hand-written ones),
+/// routes.rou.xml (vTypeDistribution "mixed" of cav_fast, cav_slow, hdv_fast, hdv_slow built from
 /// <scenario_dir>/vtypes.xml; one route per origin-destination pair; one flow per route with a
 /// non-zero share) and scenario.sumocfg (no output files).
 /// @throws std::invalid_argument for a bad config (nothing is written: the scalar checks run
 ///         first; a route-share error is found after netconvert, and then only the network
-///         file exists); std::runtime_error when netconvert fails or a file cannot be written.
+///         file and its sources exist); std::runtime_error when netconvert fails or a file
+///         cannot be written.
 ScenarioFiles writeScenario(const ScenarioConfig& config, const std::string& out_dir);
 
 }  // namespace palcas::sim
