@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
 CPP
 g++ -std=c++17 -O2 -I"$SIM/include" -I"$SIM/lib" "$WORK/write_scenario.cpp" \
   "$SIM/lib/scenario_xml.cpp" "$SIM/lib/scenario_network.cpp" "$SIM/lib/scenario_config.cpp" \
-  "$SIM/lib/scenario_writer.cpp" "$SIM/lib/road_layout.cpp" -o "$WORK/write_scenario"
+  "$SIM/lib/scenario_writer.cpp" "$SIM/lib/road_layout.cpp" "$SIM/lib/road_spec.cpp" -o "$WORK/write_scenario"
 CFG="$("$WORK/write_scenario" "$ROOT/config/scenarios/paper" "$WORK/scenario" "$PR" "$DURATION_S" "$SEED")"
 
 echo "scenario: paper, PR $PR, ${DURATION_S} s simulated, seed $SEED, step 0.1 s ($CFG)"

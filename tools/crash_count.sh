@@ -23,8 +23,6 @@ done
 export PATH="/usr/bin:/bin:$PATH"
 set +u; source "$ROOT/devel/setup.bash"; set -u
 mkdir -p "$OUT"
-clusters="$(/usr/bin/python3 -c 'import sys,yaml; print(len(yaml.safe_load(open(sys.argv[1]))["zones_m"]) - 1)' \
-  "$ROOT/config/scenarios/$SCENARIO/rsus.yaml")"
 died=0
 for ((k = FIRST; k < FIRST + N; k++)); do
   dir="$OUT/seed$k"
@@ -32,7 +30,7 @@ for ((k = FIRST; k < FIRST + N; k++)); do
   port="$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1",0)); print(s.getsockname()[1])')"
   ROS_MASTER_URI="http://127.0.0.1:$port" ROS_HOSTNAME=127.0.0.1 ROS_LOG_DIR="$dir/ros_log" \
     timeout -k 10 900 roslaunch -p "$port" palcas_launch system.launch arm:=palcas mode:=train scenario:="$SCENARIO" \
-    clusters:="$clusters" seed:="$k" duration:="$DURATION" out_dir:="$dir" \
+    seed:="$k" duration:="$DURATION" out_dir:="$dir" \
     checkpoint_dir:="$dir/checkpoints" bridge_params:="$BRIDGE" >"$dir/console.log" 2>&1
   if [ -f "$dir/metrics.json" ]; then
     echo "seed $k: completed ${DURATION} s"

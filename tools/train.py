@@ -192,12 +192,12 @@ def free_port():
 
 
 def scenario_clusters(root, scenario):
-    """Zones in config/scenarios/<name>/rsus.yaml (zones_m has one more boundary)."""
-    text = read_text(os.path.join(root, "config", "scenarios", scenario, "rsus.yaml"))
-    m = re.search(r"^zones_m:\s*\[([^\]]*)\]", text, re.M)
+    """road/clusters of config/scenarios/<name>/scenario.yaml (the launch files read the same line)."""
+    text = read_text(os.path.join(root, "config", "scenarios", scenario, "scenario.yaml"))
+    m = re.search(r"^\s*clusters:\s*(\d+)", text, re.M)
     if not m:
-        raise OptionError("--scenario %s: its rsus.yaml has no zones_m" % scenario)
-    return len([v for v in m.group(1).split(",") if v.strip()]) - 1
+        raise OptionError("--scenario %s: its scenario.yaml has no road/clusters" % scenario)
+    return int(m.group(1))
 
 
 def rsu_ids(arm, clusters):

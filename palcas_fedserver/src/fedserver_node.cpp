@@ -4,11 +4,13 @@
 #include <std_msgs/UInt32.h>
 
 #include <palcas_core/pdqn_agent.h>
+#include <palcas_core/state_layout.h>
 
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
 #include <palcas_common/model_weights.h>
 #include "palcas_fedserver/topics.h"
@@ -18,6 +20,7 @@ namespace palcas::fedserver {
 FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), private_nh_(private_nh), options_(loadFedServerOptions(private_nh_)),
       server_(options_.federation), auth_key_(common::loadMessageKey(options_.auth_key_file)) {
+  if (options_.learning.state_size == 0) takeStateSizeFromTheRoad();
   initializeModel();
   status_pub_ = nh_.advertise<std_msgs::String>(FEDERATION_STATUS_TOPIC, 1, true);
   version_pub_ = nh_.advertise<std_msgs::UInt32>(GLOBAL_MODEL_VERSION_TOPIC, 1, true);
@@ -40,6 +43,18 @@ FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
              options_.auth_key_file.c_str(), auth_key_->fingerprint().c_str());
   else
     ROS_WARN("palcas fedserver: ~auth_key_file not set: submissions are NOT authenticated");
+}
+
+void FedServerNode::takeStateSizeFromTheRoad() {
+  // ~learning/state_size 0: 40 + the lane count of the bridge's road, as every RSU does.
+  const auto road = common::waitForBridgeRoad(nh_, options_.road_wait_s);
+  if (!road)
+    throw std::runtime_error(std::string("~learning/state_size is 0 (from the road) but the bridge published no ") +
+                             common::ROAD_LANES_PARAM + " within ~road_wait_s = " +
+                             std::to_string(options_.road_wait_s) + " s");
+  options_.learning.state_size = StateLayout(road->num_lanes).size();
+  ROS_INFO("palcas fedserver: state size %d (40 + the road's %d lanes)", options_.learning.state_size,
+           road->num_lanes);
 }
 
 void FedServerNode::initializeModel() {

@@ -37,6 +37,7 @@ FedServerOptions loadFedServerOptions(const ros::NodeHandle& private_nh, common:
   o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
   if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
   o.poll_period_s = p.number("poll_period_s", o.poll_period_s, 1e-3, 3600.0);
+  o.road_wait_s = p.number("road_wait_s", o.road_wait_s, 0.0, 3600.0);
   try {
     f.validate();
   } catch (const std::invalid_argument& e) {

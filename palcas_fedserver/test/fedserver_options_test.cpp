@@ -36,7 +36,7 @@ TEST(FedServerOptions, ShippedFilesLoad) {
   EXPECT_DOUBLE_EQ(o.federation.liveness_timeout_s, palcas::FederationOptions{}.liveness_timeout_s);
   EXPECT_EQ(o.federation.max_samples, 1000000000u);  // fedserver.yaml
   EXPECT_EQ(o.learning.hidden_sizes, (std::vector<int>{256, 512, 256}));  // paper
-  EXPECT_EQ(o.learning.state_size, 45);                                    // paper
+  EXPECT_EQ(o.learning.state_size, 0);  // from the bridge's road (40 + L)
   EXPECT_FLOAT_EQ(o.learning.gamma, 0.995f);                               // paper
   EXPECT_EQ(o.learning.seed, 1u);
   EXPECT_EQ(o.checkpoint_dir, "");

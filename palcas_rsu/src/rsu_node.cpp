@@ -1,5 +1,6 @@
 #include "palcas_rsu/rsu_node.h"
 
+#include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
 #include <palcas_common/model_weights.h>
 #include <palcas_msgs/AdvisoryArray.h>
@@ -14,8 +15,26 @@
 namespace palcas::rsu {
 namespace fs = std::filesystem;
 
+namespace {
+
+/// The node's options with what they leave to the bridge's road filled in from it (the
+/// bridge sets it before opening registration; an RSU may start first, so wait for it).
+RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
+  RsuNodeOptions o = loadRsuNodeOptions(private_nh);
+  if (!takesFromBridgeRoad(o)) return o;  // all set here: checked at registration
+  const auto road = common::waitForBridgeRoad(nh, o.register_timeout_s);
+  if (!road)
+    throw std::runtime_error(std::string("no road from the bridge (") + common::ROAD_ZONES_PARAM + ", " +
+                             common::ROAD_LANES_PARAM + ") after " + std::to_string(o.register_timeout_s) +
+                             " s; without a bridge set ~zones_m, ~rsu/num_lanes and ~learning/state_size");
+  adoptBridgeRoad(o, road->zones_m, road->num_lanes);
+  return o;
+}
+
+}  // namespace
+
 RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), private_nh_(private_nh), options_(loadRsuNodeOptions(private_nh_)),
+    : nh_(nh), private_nh_(private_nh), options_(loadOptionsOnTheRoad(nh_, private_nh_)),
       controller_(std::make_unique<RsuController>(options_.controller)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s),
@@ -117,10 +136,7 @@ void RsuNode::registerWithBridge() {
   }
   // The bridge published its road before opening registration: refuse a zone or lane
   // count that is not on it, naming both (the node ends; its supervisor reports it).
-  std::vector<double> road_zones;
-  int road_lanes = 0;
-  if (nh_.getParam(ROAD_ZONES_PARAM, road_zones) && nh_.getParam(ROAD_LANES_PARAM, road_lanes))
-    checkAgainstRoad(options_, road_zones, road_lanes);
+  if (const auto road = common::bridgeRoad(nh_)) checkAgainstRoad(options_, road->zones_m, road->num_lanes);
   // Registering starts the bridge's step 0: make sure its states reach us first.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
   while (ros::ok() && states_sub_.getNumPublishers() == 0 && ros::WallTime::now() < deadline)

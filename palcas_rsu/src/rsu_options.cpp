@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "palcas_common/core_params.h"
+#include "palcas_core/state_layout.h"
 
 namespace palcas::rsu {
 
@@ -18,27 +19,12 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   c.cluster_index = p.integer("rsu/cluster_index", c.cluster_index, 0, 1000);
   c.x_start_m = p.number("rsu/x_start_m", c.x_start_m, -1e9, 1e9);
   c.x_end_m = p.number("rsu/x_end_m", c.x_end_m, -1e9, 1e9);
-  // The scenario's zones (config/scenarios/<name>/rsus.yaml) give the bounds when present.
+  // Zones, lane count and state size come from the bridge's road unless set here (then they
+  // are checked against it): adoptBridgeRoad.
   o.zones_m = p.get<std::vector<double>>("zones_m", {});
   o.whole_road = p.get<bool>("whole_road", false);
-  if (!o.zones_m.empty()) {
-    for (std::size_t i = 1; i < o.zones_m.size(); ++i)
-      if (!(o.zones_m[i] > o.zones_m[i - 1]))
-        throw std::invalid_argument("parameter '" + p.fullName("zones_m") + "' must increase");
-    const int zones = static_cast<int>(o.zones_m.size()) - 1;
-    if (o.whole_road) {
-      c.x_start_m = o.zones_m.front();
-      c.x_end_m = o.zones_m.back();
-    } else if (c.cluster_index >= zones) {
-      throw std::invalid_argument("parameter '" + p.fullName("rsu/cluster_index") + "' = " +
-                                  std::to_string(c.cluster_index) + " but '" + p.fullName("zones_m") +
-                                  "' has " + std::to_string(zones) + " zone(s)");
-    } else {
-      c.x_start_m = o.zones_m[c.cluster_index];
-      c.x_end_m = o.zones_m[c.cluster_index + 1];
-    }
-  }
-  c.num_lanes = p.integer("rsu/num_lanes", c.num_lanes, 1, 100);
+  if (!o.zones_m.empty()) applyZones(o, p.fullName("zones_m"));
+  c.num_lanes = p.integer("rsu/num_lanes", 0, 0, 100);  // 0 = the bridge's road
   c.train = p.get<bool>("rsu/train", c.train);
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
@@ -72,8 +58,44 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   o.i2i_stale_after_s = p.number("i2i_stale_after_s", o.i2i_stale_after_s, 1e-3, 1e9);
   o.register_timeout_s = p.number("register_timeout_s", o.register_timeout_s, 0.0, 3600.0);
   p.rejectUnknownKeys("palcas_rsu/README.md");
-  c.validate();
+  if (!takesFromBridgeRoad(o)) c.validate();  // else adoptBridgeRoad validates
   return o;
+}
+
+void applyZones(RsuNodeOptions& o, const std::string& zones_name) {
+  RsuControllerOptions& c = o.controller;
+  for (std::size_t i = 1; i < o.zones_m.size(); ++i)
+    if (!(o.zones_m[i] > o.zones_m[i - 1]))
+      throw std::invalid_argument("parameter '" + zones_name + "' must increase");
+  const int zones = static_cast<int>(o.zones_m.size()) - 1;
+  if (zones < 1) throw std::invalid_argument("parameter '" + zones_name + "' needs at least 2 boundaries");
+  if (o.whole_road) {
+    c.x_start_m = o.zones_m.front();
+    c.x_end_m = o.zones_m.back();
+  } else if (c.cluster_index >= zones) {
+    throw std::invalid_argument("rsu/cluster_index = " + std::to_string(c.cluster_index) + " but '" +
+                                zones_name + "' has " + std::to_string(zones) + " zone(s)");
+  } else {
+    c.x_start_m = o.zones_m[c.cluster_index];
+    c.x_end_m = o.zones_m[c.cluster_index + 1];
+  }
+}
+
+bool takesFromBridgeRoad(const RsuNodeOptions& o) {
+  return o.zones_m.empty() || o.controller.num_lanes == 0 || o.controller.pdqn.state_size == 0;
+}
+
+void adoptBridgeRoad(RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes) {
+  RsuControllerOptions& c = o.controller;
+  if (road_lanes < 1) throw std::invalid_argument("the bridge's road has " + std::to_string(road_lanes) + " lanes");
+  if (o.zones_m.empty()) {
+    o.zones_m = road_zones_m;
+    applyZones(o, "the bridge's road zones");
+  }
+  if (c.num_lanes == 0) c.num_lanes = road_lanes;
+  if (c.pdqn.state_size == 0) c.pdqn.state_size = StateLayout(c.num_lanes).size();
+  checkAgainstRoad(o, road_zones_m, road_lanes);
+  c.validate();
 }
 
 void checkAgainstRoad(const RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes) {

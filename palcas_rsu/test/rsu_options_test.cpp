@@ -28,15 +28,46 @@ void expectRefused(const std::string& name, const std::function<void(ros::NodeHa
 }  // namespace
 
 TEST(RsuOptions, ShippedFilesLoadForTheSecondZone) {
-  const auto o = loadRsuNodeOptions(ros::NodeHandle("~shipped"));
+  auto o = loadRsuNodeOptions(ros::NodeHandle("~shipped"));
   EXPECT_EQ(o.controller.rsu_id, "rsu_1");
-  EXPECT_DOUBLE_EQ(o.controller.x_start_m, 800.0);  // from zones_m, not rsu.yaml
+  EXPECT_TRUE(palcas::rsu::takesFromBridgeRoad(o));  // zones, lanes and state size
+  palcas::rsu::adoptBridgeRoad(o, {0.0, 800.0, 1600.0, 2400.0}, 5);
+  EXPECT_DOUBLE_EQ(o.controller.x_start_m, 800.0);
   EXPECT_DOUBLE_EQ(o.controller.x_end_m, 1600.0);
   EXPECT_EQ(o.controller.num_lanes, 5);
+  EXPECT_EQ(o.controller.pdqn.state_size, 45);  // the paper's, from its 5 lanes
   EXPECT_EQ(o.decision_period_steps, 10);
   EXPECT_TRUE(o.controller.reward_over_period);  // departures.yaml
   EXPECT_FLOAT_EQ(o.controller.pdqn.gamma, 0.97f);
   EXPECT_DOUBLE_EQ(o.federation_heartbeat_s, 10.0);
+}
+
+TEST(RsuOptions, AFourLaneFourZoneRoadGivesItsZoneAndStateSize) {
+  auto o = loadRsuNodeOptions(caseFrom("four", [](ros::NodeHandle& nh) { nh.setParam("rsu/cluster_index", 3); }));
+  palcas::rsu::adoptBridgeRoad(o, {0.0, 300.0, 600.0, 900.0, 1200.0}, 4);
+  EXPECT_DOUBLE_EQ(o.controller.x_start_m, 900.0);
+  EXPECT_DOUBLE_EQ(o.controller.x_end_m, 1200.0);
+  EXPECT_EQ(o.controller.num_lanes, 4);
+  EXPECT_EQ(o.controller.pdqn.state_size, 44);
+}
+
+TEST(RsuOptions, WhatIsPinnedMustFitTheBridgesRoad) {
+  auto expectMismatch = [](const std::string& name, const std::function<void(ros::NodeHandle&)>& change,
+                           const std::string& needle) {
+    auto o = loadRsuNodeOptions(caseFrom(name, change));
+    try {
+      palcas::rsu::adoptBridgeRoad(o, {0.0, 800.0, 1600.0, 2400.0}, 4);
+      ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  expectMismatch("lanes5", [](ros::NodeHandle& nh) { nh.setParam("rsu/num_lanes", 5); },
+                 "the bridge's road has 4 lanes but rsu/num_lanes is 5");
+  expectMismatch("state45", [](ros::NodeHandle& nh) { nh.setParam("learning/state_size", 45); },
+                 "must be 40 + num_lanes = 44");
+  expectMismatch("zones", [](ros::NodeHandle& nh) { nh.setParam("zones_m", std::vector<double>{0, 600, 1200}); },
+                 "this RSU's zone is [600.0, 1200.0) m but zone 1 of the bridge's road is [800.0, 1600.0) m");
 }
 
 TEST(RsuOptions, EveryKeyOfTheDefaultFilesEqualsTheCompiledInDefault) {
@@ -74,8 +105,11 @@ TEST(RsuOptions, TheDefaultsCheckCanFail) {
 TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
   expectRefused("typo", [](ros::NodeHandle& nh) { nh.setParam("rsu/decision_period_step", 5); },
                 "rsu/decision_period_step");
-  expectRefused("lanes", [](ros::NodeHandle& nh) { nh.setParam("rsu/num_lanes", 0); }, "rsu/num_lanes");
-  expectRefused("zone", [](ros::NodeHandle& nh) { nh.setParam("rsu/cluster_index", 3); }, "has 3 zone(s)");
+  expectRefused("lanes", [](ros::NodeHandle& nh) { nh.setParam("rsu/num_lanes", -1); }, "rsu/num_lanes");
+  expectRefused("zone", [](ros::NodeHandle& nh) {
+    nh.setParam("rsu/cluster_index", 3);
+    nh.setParam("zones_m", std::vector<double>{0, 800, 1600, 2400});
+  }, "has 3 zone(s)");
   expectRefused("order", [](ros::NodeHandle& nh) { nh.setParam("zones_m", std::vector<double>{0, 800, 700}); },
                 "must increase");
   expectRefused("period", [](ros::NodeHandle& nh) { nh.setParam("rsu/decision_period_steps", 2.5); },

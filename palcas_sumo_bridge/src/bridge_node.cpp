@@ -1,5 +1,6 @@
 #include "palcas_sumo_bridge/bridge_node.h"
 
+#include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
 #include <palcas_core/advisory_validator.h>
 #include <palcas_msgs/AdvisoryRejection.h>
@@ -68,8 +69,8 @@ void BridgeNode::publishRoad() {
     if (zones.empty()) zones.push_back(c.x_start_m);
     zones.push_back(c.x_end_m);
   }
-  nh_.setParam(ROAD_ZONES_PARAM, zones);
-  nh_.setParam(ROAD_LANES_PARAM, session_->road().numMainLanes());
+  nh_.setParam(common::ROAD_ZONES_PARAM, zones);
+  nh_.setParam(common::ROAD_LANES_PARAM, session_->road().numMainLanes());
 }
 
 void BridgeNode::advertise() {

@@ -33,7 +33,19 @@ std::map<std::string, sim::RouteShares> readShares(palcas::common::ParamReader& 
 sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::NodeHandle& nh) {
   sim::ScenarioConfig c;
   p.accept("scenario/scenario_dir");  // the launch's ~scenario_dir wins
-  c.cluster_length_m = p.number("scenario/cluster_length_m", c.cluster_length_m, 1.0, 1e5);
+  // The road (sim::RoadSpec): ranges here, the geometry's consistency in validateRoadSpec.
+  sim::RoadSpec& r = c.road;
+  r.clusters = p.integer("scenario/road/clusters", r.clusters, 1, 1000);
+  r.num_lanes = p.integer("scenario/road/num_lanes", r.num_lanes, 1, 100);
+  for (auto [name, value] : {std::pair{"cluster_length_m", &r.cluster_length_m},
+                             std::pair{"warmup_length_m", &r.warmup_length_m},
+                             std::pair{"merge_start_m", &r.merge_start_m},
+                             std::pair{"acceleration_lane_m", &r.acceleration_lane_m},
+                             std::pair{"exit_m", &r.exit_m}, std::pair{"lane_width_m", &r.lane_width_m},
+                             std::pair{"speed_limit_mps", &r.speed_limit_mps},
+                             std::pair{"ramp_speed_limit_mps", &r.ramp_speed_limit_mps}})
+    *value = p.number(std::string("scenario/road/") + name, *value, 1e-3, 1e6);
+  c.generate_network = p.get<bool>("scenario/generate_network", c.generate_network);
   c.penetration_rate = p.number("scenario/penetration_rate", c.penetration_rate, 0.0, 1.0);
   c.seed = static_cast<unsigned int>(p.integer("scenario/seed", static_cast<int>(c.seed), 0, 2147483647));
   c.duration_s = p.number("scenario/duration_s", c.duration_s, 0.1, 1e7);
@@ -95,7 +107,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.cav_max_decel_mps2 = p.number("cav_max_decel_mps2", o.session.cav_max_decel_mps2, 0.0, 20.0);
   o.session.comfortable_lane_changes =
       p.get<bool>("comfortable_lane_changes", o.session.comfortable_lane_changes);
-  o.session.cluster_length_m = o.scenario.cluster_length_m;
+  o.session.cluster_length_m = o.scenario.road.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
   o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);
   o.startup_timeout_s = p.number("startup_timeout_s", o.startup_timeout_s, 0.0, 3600.0);

@@ -59,10 +59,23 @@ json insertion(const sim::InsertionSettings& i) {
 }
 
 json scenarioJson(const sim::ScenarioConfig& c) {
-  json shares = json::object();
-  for (const auto& [source, dest] : c.route_shares) shares[source] = dest;
+  json shares = json::object();  // the shares in effect: an empty map is the default rule
+  for (const auto& [source, dest] : c.route_shares.empty() ? sim::defaultRouteShares(c.road.clusters) : c.route_shares)
+    shares[source] = dest;
+  const sim::RoadSpec& r = c.road;
+  const json road = {{"clusters", r.clusters},
+                     {"num_lanes", r.num_lanes},
+                     {"cluster_length_m", r.cluster_length_m},
+                     {"warmup_length_m", r.warmup_length_m},
+                     {"merge_start_m", r.merge_start_m},
+                     {"acceleration_lane_m", r.acceleration_lane_m},
+                     {"exit_m", r.exit_m},
+                     {"lane_width_m", r.lane_width_m},
+                     {"speed_limit_mps", r.speed_limit_mps},
+                     {"ramp_speed_limit_mps", r.ramp_speed_limit_mps}};
   return {{"scenario_dir", c.scenario_dir},
-          {"cluster_length_m", c.cluster_length_m},
+          {"road", road},
+          {"generate_network", c.generate_network},
           {"penetration_rate", c.penetration_rate},
           {"seed", c.seed},
           {"duration_s", c.duration_s},

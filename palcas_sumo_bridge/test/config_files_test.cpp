@@ -13,11 +13,14 @@ TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   const auto o = loadBridgeOptions(ros::NodeHandle("~paper"));
   EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 1000.0);  // calibrated (README, departures)
   EXPECT_DOUBLE_EQ(o.scenario.onramp_flow_vphpl, 600.0);     // paper
-  EXPECT_DOUBLE_EQ(o.scenario.cluster_length_m, 800.0);      // paper
+  EXPECT_DOUBLE_EQ(o.scenario.road.cluster_length_m, 800.0);      // paper
   EXPECT_DOUBLE_EQ(o.scenario.step_length_s, 0.1);
   EXPECT_DOUBLE_EQ(o.scenario.lateral_resolution_m, 3.2);
   EXPECT_DOUBLE_EQ(o.scenario.cav_speed.fast_mps, 33.528);
-  EXPECT_EQ(o.scenario.route_shares.at("main").at("end"), 0.55);
+  EXPECT_TRUE(o.scenario.route_shares.empty());  // the default rule (defaultRouteShares)
+  EXPECT_EQ(o.scenario.road.clusters, 3);         // paper
+  EXPECT_EQ(o.scenario.road.num_lanes, 5);        // paper
+  EXPECT_TRUE(o.scenario.generate_network);
   EXPECT_DOUBLE_EQ(o.session.cluster_length_m, 800.0);
   EXPECT_DOUBLE_EQ(o.session.lane_change_duration_s, 2.0);  // paper
   EXPECT_DOUBLE_EQ(o.comfort_threshold_mps2, 1.47);         // paper
@@ -34,13 +37,14 @@ TEST(ConfigFiles, PrintedDemandScenarioLoads) {
   const auto o = loadBridgeOptions(ros::NodeHandle("~paper_printed"));
   EXPECT_DOUBLE_EQ(o.scenario.mainline_flow_vphpl, 3200.0);  // paper, as printed
   EXPECT_DOUBLE_EQ(o.scenario.onramp_flow_vphpl, 600.0);     // paper
-  EXPECT_DOUBLE_EQ(o.scenario.cluster_length_m, 800.0);
+  EXPECT_DOUBLE_EQ(o.scenario.road.cluster_length_m, 800.0);
 }
 
 TEST(ConfigFiles, TinyScenarioLoads) {
   const auto o = loadBridgeOptions(ros::NodeHandle("~tiny"));
-  EXPECT_LT(o.scenario.cluster_length_m, 800.0);
-  EXPECT_FALSE(o.scenario.route_shares.empty());
+  EXPECT_DOUBLE_EQ(o.scenario.road.cluster_length_m, 300.0);
+  EXPECT_EQ(o.scenario.road.clusters, 2);
+  EXPECT_EQ(o.scenario.road.num_lanes, 3);
 }
 
 TEST(ConfigFiles, EveryKeyOfBridgeYamlEqualsTheCompiledInDefault) {

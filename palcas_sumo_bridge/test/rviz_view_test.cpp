@@ -20,7 +20,7 @@ using palcas::bridge::WindowPx;
 
 namespace {
 
-// Lane centre extents of the shipped roads (config/scenarios/*/network.nod.xml: mainline
+// Lane centre extents of the shipped roads (generated from config/scenarios/*/scenario.yaml: mainline
 // from x = 0 along y = 0 downwards, on-ramps starting lower).
 const RoadExtent PAPER{0.0, 2400.0, -36.0, -1.6};
 const RoadExtent TINY{0.0, 600.0, -21.6, -1.6};

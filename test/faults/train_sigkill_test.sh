@@ -6,6 +6,7 @@
 #   - the resumed trainings end with exactly the episodes of an uninterrupted run: episode
 #     numbers 0, 1, 2 once each, each a whole 1200 s (an interrupted one is redone);
 #   - every checkpoint loads: the last resume starts its nodes from them and succeeds.
+# And ./palcas run killed outright mid-run leaves no process either.
 # Asserts on files and process lists, not on timing. About four minutes.
 #
 #   test/faults/train_sigkill_test.sh [--xml FILE]
@@ -61,4 +62,26 @@ print("episodes", episodes, "sim_seconds", [r["sim_seconds"] for r in rows])
 sys.exit(0 if ok else 1)
 EOF
 result episodes_once_each_and_whole "$why"
+# ./palcas run, SIGKILLed while its simulation runs: roslaunch gets SIGINT from its
+# parent-death signal and stops every node.
+RUN_OUT="$WORK/run"
+why=""
+(exec env PALCAS_NO_BUILD=1 "$ROOT/palcas" run --scenario tiny --arm keep --no-compare --duration 36000 \
+  --out "$RUN_OUT" >>"$WORK/run.log" 2>&1) &
+run_pid=$!
+end=$((SECONDS + 120))
+until grep -q "palcas bridge: " "$RUN_OUT"/*/console.log 2>/dev/null || [ $SECONDS -ge $end ]; do sleep 0.5; done
+if ! pgrep -f "$RUN_OUT/" >/dev/null; then
+  why="./palcas run started no node within 120 s: $(tail -3 "$WORK/run.log" | tr '\n' ' ')"
+else
+  kill -9 "$run_pid"
+  wait "$run_pid" 2>/dev/null
+  end=$((SECONDS + 60))
+  while pgrep -f "$RUN_OUT/" >/dev/null && [ $SECONDS -lt $end ]; do sleep 0.5; done
+  left="$(pgrep -af "$RUN_OUT/" | cut -c1-120 | tr '\n' ';')"
+  [ -z "$left" ] || why="processes left 60 s after SIGKILL of ./palcas run: $left"
+fi
+pkill -9 -f "$RUN_OUT/" 2>/dev/null
+result run_sigkill_no_orphans "$why"
+
 grep -a -E "^kill [0-9]|training folder|error|ended early|resum" "$WORK/train.log" | head -20

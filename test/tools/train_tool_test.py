@@ -118,11 +118,42 @@ class ConsoleLog(unittest.TestCase):
         self.assertEqual(train.crash_reason("all fine"), "")
         self.assertIn("[FATAL]", train.last_fatal("[ INFO] ok\n[FATAL] [1.0]: bad key\n"))
 
-    def test_clusters_come_from_the_roads_zones(self):
+    def test_clusters_come_from_the_roads_description(self):
         self.assertEqual(train.scenario_clusters(str(ROOT), "paper"), 3)
         self.assertEqual(train.scenario_clusters(str(ROOT), "tiny"), 2)
         self.assertEqual(train.rsu_ids("centralized", 3), ["central"])
         self.assertEqual(train.rsu_ids("palcas", 2), ["rsu_0", "rsu_1"])
+
+
+class ScenarioFiles(unittest.TestCase):
+    """One description per road: each scenario folder holds scenario.yaml and vtypes.xml, and
+    the RSU count system.launch derives from it (roslaunch cannot parse YAML, it reads the
+    clusters: line) is the YAML's road/clusters."""
+
+    def launch_rsu_count(self, scenario_dir):
+        import xml.etree.ElementTree as ET
+        from roslaunch.substitution_args import resolve_args
+        args = {a.get("name"): a.get("value") for a in ET.parse(str(ROOT / "launch/system.launch")).getroot().iter("arg")}
+        return int(resolve_args(args["rsu_count"], context={"arg": {"clusters": "auto", "scenario_dir": scenario_dir}}))
+
+    def test_every_scenario_is_one_yaml_whose_cluster_count_the_launch_reads(self):
+        import yaml
+        folders = sorted((ROOT / "config/scenarios").iterdir())
+        self.assertGreaterEqual(len([f for f in folders if f.is_dir()]), 3)
+        for folder in folders:
+            if not folder.is_dir():
+                continue
+            road = yaml.safe_load((folder / "scenario.yaml").read_text())["road"]
+            self.assertEqual(self.launch_rsu_count(str(folder)), road["clusters"], folder.name)
+            self.assertEqual(train.scenario_clusters(str(ROOT), folder.name), road["clusters"], folder.name)
+            for gone in ("rsus.yaml", "learning.yaml", "network.nod.xml"):
+                self.assertFalse((folder / gone).exists(), "%s/%s: the road is generated" % (folder.name, gone))
+
+    def test_the_launch_reads_a_changed_cluster_count(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        text = (ROOT / "config/scenarios/tiny/scenario.yaml").read_text()
+        (folder / "scenario.yaml").write_text(text.replace("clusters: 2", "clusters: 4", 1))
+        self.assertEqual(self.launch_rsu_count(str(folder)), 4)
 
 
 if __name__ == "__main__":

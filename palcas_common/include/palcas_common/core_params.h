@@ -36,7 +36,9 @@ inline PdqnConfig loadPdqnConfig(palcas::common::ParamReader& p, const std::stri
   constexpr int BIG = std::numeric_limits<int>::max();
   const std::string k = ns + "/";
   PdqnConfig c;
-  c.state_size = p.integer(k + "state_size", c.state_size, 1, BIG);
+  // 0 (the shipped value) = 40 + the lane count of the bridge's road, filled in by the node
+  // before it builds a network (palcas_common/bridge_road.h); a number pins it and is checked.
+  c.state_size = p.integer(k + "state_size", 0, 0, BIG);
   c.hidden_sizes = p.get<std::vector<int>>(k + "hidden_sizes", c.hidden_sizes);
   c.batch_norm = p.get<bool>(k + "batch_norm", c.batch_norm);
   c.dropout = static_cast<float>(p.number(k + "dropout", c.dropout, 0.0, 1.0));
@@ -65,7 +67,9 @@ inline PdqnConfig loadPdqnConfig(palcas::common::ParamReader& p, const std::stri
   c.epsilon_linear_rounds = p.number(k + "epsilon_linear_rounds", c.epsilon_linear_rounds, 0.0, 1e15);
   c.seed = static_cast<std::uint64_t>(p.integer(k + "seed", static_cast<int>(c.seed), 0, BIG));
   try {
-    c.validate();
+    PdqnConfig checked = c;  // a state size left to the road is checked once it is known
+    if (checked.state_size == 0) checked.state_size = 41;  // 40 + L, L >= 1
+    checked.validate();
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("parameters ~" + ns + "/*: " + e.what());
   }

@@ -24,6 +24,8 @@ class FedServerNode {
   FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
 
  private:
+  /// ~learning/state_size 0: waits for the bridge's road and uses 40 + its lane count.
+  void takeStateSizeFromTheRoad();
   /// Fresh start: PdqnAgent(learning).exportModel(); resume: the checkpoint, whose
   /// layout must be the learning config's (otherwise no RSU could submit to it).
   void initializeModel();

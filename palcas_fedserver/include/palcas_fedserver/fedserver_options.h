@@ -23,6 +23,8 @@ struct FedServerOptions {
   std::string auth_key_file;
   bool resume = false;                   ///< start from checkpoint_dir instead of a fresh model
   double poll_period_s = 0.5;            ///< ROS-time period of the round-closing timer [s]
+  /// Wall time to wait for the bridge's road when ~learning/state_size is 0 (from the road) [s].
+  double road_wait_s = 60.0;
 };
 
 /// Reads the node's private parameters. @throws std::invalid_argument naming the key for

@@ -14,7 +14,7 @@ namespace palcas::rsu {
 
 struct RsuNodeOptions {
   RsuControllerOptions controller;
-  /// Zone boundaries of the scenario (~zones_m); RSU k manages [zones[k], zones[k+1]).
+  /// Zone boundaries (~zones_m); RSU k manages [zones[k], zones[k+1]). Empty = the bridge's.
   std::vector<double> zones_m;
   bool whole_road = false;           ///< centralized baseline: one zone over every cluster
   int decision_period_steps = 10;    ///< bridge steps between decisions (1 s at 0.1 s steps)
@@ -42,6 +42,20 @@ struct RsuNodeOptions {
 /// @throws std::invalid_argument naming the key for a bad, unknown or missing parameter.
 RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh,
                                   common::ParamDefaults* defaults = nullptr);
+
+/// Sets x_start_m / x_end_m from zones_m and cluster_index (or the whole range for a
+/// whole_road RSU). @throws std::invalid_argument naming zones_name when the zones do not
+/// increase or have no zone for this cluster index.
+void applyZones(RsuNodeOptions& o, const std::string& zones_name);
+
+/// True when the zones, the lane count or the state size are left to the bridge's road
+/// (~zones_m empty, ~rsu/num_lanes 0 or ~learning/state_size 0: the shipped files).
+bool takesFromBridgeRoad(const RsuNodeOptions& o);
+
+/// Fills what is left to the bridge's road (zones, L, state size 40 + L), checks what was
+/// set against it (checkAgainstRoad) and validates the whole. @throws std::invalid_argument
+/// naming both values on a mismatch, or the bad field.
+void adoptBridgeRoad(RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes);
 
 /// Checks this RSU's zone and lane count against the bridge's road (zone boundaries along
 /// the mainline and lane count, as the bridge publishes them). A centralized RSU (whole_road)

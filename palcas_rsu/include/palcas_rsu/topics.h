@@ -4,9 +4,6 @@
 
 namespace palcas::rsu {
 
-// The bridge's road (set by the bridge before it opens registration; absolute names).
-constexpr char ROAD_ZONES_PARAM[] = "/palcas/road_zones_m";
-constexpr char ROAD_LANES_PARAM[] = "/palcas/road_num_lanes";
 constexpr char VEHICLE_STATES_TOPIC[] = "vehicle_states";    // in: palcas_msgs/VehicleStateArray
 constexpr char VEHICLE_EVENTS_TOPIC[] = "vehicle_events";    // in: palcas_msgs/VehicleEventArray
 constexpr char CLUSTER_STATES_TOPIC[] = "cluster_states";    // in/out (I2I): palcas_msgs/ClusterState

@@ -4,10 +4,7 @@
 
 namespace palcas::bridge {
 
-// The bridge's road for the RSUs to check theirs against (absolute: RSUs live in their own
-// namespaces): zone boundaries along the mainline [m] and the mainline lane count.
-constexpr char ROAD_ZONES_PARAM[] = "/palcas/road_zones_m";
-constexpr char ROAD_LANES_PARAM[] = "/palcas/road_num_lanes";
+// The road the bridge publishes for the RSUs and the server: palcas_common/bridge_road.h.
 constexpr char VEHICLE_STATES_TOPIC[] = "vehicle_states";      // palcas_msgs/VehicleStateArray
 constexpr char VEHICLE_EVENTS_TOPIC[] = "vehicle_events";      // palcas_msgs/VehicleEventArray
 constexpr char EPISODE_METRICS_TOPIC[] = "episode_metrics";    // palcas_msgs/EpisodeMetrics
