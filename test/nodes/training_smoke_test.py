@@ -34,7 +34,7 @@ class TrainingSmokeTest(unittest.TestCase):
         env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
         run = subprocess.run(
             ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=palcas", "mode:=train", "scenario:=tiny",
-             "clusters:=2", "seed:=%d" % seed, "duration:=120", "checkpoint_dir:=" + out + "/checkpoints",
+             "seed:=%d" % seed, "duration:=120", "checkpoint_dir:=" + out + "/checkpoints",
              "out_dir:=" + out, "learning_params:=%s/training/short_learning.yaml" % config,
              "rsu_params:=%s/training/short_rsu.yaml" % config],
             env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=400, text=True)
