@@ -32,6 +32,30 @@ std::map<std::string, EdgeInfo> byId(const std::vector<EdgeInfo>& edges) {
 
 using Link = std::tuple<std::string, int, std::string, int>;
 
+/// Every cluster of `road` sits where `spec` puts it: zone, ramps by the naming convention,
+/// merge edge of L + 1 lanes, acceleration lane and exit at the spec's offsets.
+void expectClustersOfSpec(const RoadLayout& road, const RoadSpec& spec) {
+  ASSERT_EQ(road.clusters().size(), static_cast<std::size_t>(spec.clusters));
+  EXPECT_EQ(road.numMainLanes(), spec.num_lanes);
+  EXPECT_DOUBLE_EQ(road.mainlineLengthM(), spec.clusters * spec.cluster_length_m);
+  for (int k = 0; k < spec.clusters; ++k) {
+    const auto& c = road.clusters()[k];
+    const double b = spec.cluster_length_m * k;
+    EXPECT_DOUBLE_EQ(c.x_start_m, b);
+    EXPECT_DOUBLE_EQ(c.x_end_m, b + spec.cluster_length_m);
+    EXPECT_EQ(c.on_ramp_edge, "on_" + std::to_string(k));
+    EXPECT_EQ(c.merge_edge, "main_" + std::to_string(k) + "_merge");
+    EXPECT_EQ(road.edge(c.merge_edge).lane_count, spec.num_lanes + 1);  // + the acceleration lane
+    EXPECT_NEAR(c.accel_lane_x_start_m, b + spec.merge_start_m, 0.01);
+    EXPECT_NEAR(c.accel_lane_length_m, spec.acceleration_lane_m, 0.01);
+    EXPECT_EQ(c.off_ramp_edge, "off_" + std::to_string(k));
+    EXPECT_NEAR(c.exit_x_m, b + spec.exit_m, 0.01);
+    EXPECT_NEAR(road.edge("on_" + std::to_string(k)).x_start_m, b, 0.01);
+    EXPECT_NEAR(road.edge("off_" + std::to_string(k)).x_end_m, b + spec.cluster_length_m, 0.01);
+    EXPECT_LT(c.accel_lane_x_start_m + c.accel_lane_length_m, c.exit_x_m);  // merge before exit
+  }
+}
+
 std::set<Link> links(const std::vector<LaneConnection>& connections) {
   std::set<Link> out;
   for (const LaneConnection& c : connections) out.insert({c.from_edge, c.from_lane, c.to_edge, c.to_lane});
@@ -122,24 +146,7 @@ TEST(ScenarioNetwork, FourClustersOfFourLanesFromASpec) {
   const auto edges = palcas::sim::readNetEdges(net);
   EXPECT_EQ(edges.size(), 1u + 4u * 6u);  // warm-up + (up, merge, mid, down, on, off) per cluster
   const RoadLayout road(edges, 4, 500.0);
-  EXPECT_EQ(road.numMainLanes(), 4);
-  EXPECT_DOUBLE_EQ(road.mainlineLengthM(), 2000.0);  // 4 clusters x 500 m
-  ASSERT_EQ(road.clusters().size(), 4u);
-  for (int k = 0; k < 4; ++k) {
-    const auto& c = road.clusters()[k];
-    const double b = 500.0 * k;
-    EXPECT_DOUBLE_EQ(c.x_start_m, b);
-    EXPECT_DOUBLE_EQ(c.x_end_m, b + 500.0);
-    EXPECT_EQ(c.on_ramp_edge, "on_" + std::to_string(k));
-    EXPECT_EQ(c.merge_edge, "main_" + std::to_string(k) + "_merge");
-    EXPECT_EQ(road.edge(c.merge_edge).lane_count, 5);  // 4 lanes + the acceleration lane
-    EXPECT_NEAR(c.accel_lane_x_start_m, b + 80.0, 0.01);
-    EXPECT_NEAR(c.accel_lane_length_m, 150.0, 0.01);
-    EXPECT_EQ(c.off_ramp_edge, "off_" + std::to_string(k));
-    EXPECT_NEAR(c.exit_x_m, b + 400.0, 0.01);
-    EXPECT_NEAR(road.edge("on_" + std::to_string(k)).x_start_m, b, 0.01);
-    EXPECT_NEAR(road.edge("off_" + std::to_string(k)).x_end_m, b + 500.0, 0.01);
-  }
+  expectClustersOfSpec(road, spec);
   EXPECT_NEAR(road.edge("main_0_warmup").x_end_m, 50.0, 0.01);
   std::set<Link> expected;
   for (int l = 0; l < 4; ++l) expected.insert({"main_0_warmup", l, "main_0_up", l});
@@ -169,21 +176,7 @@ TEST(ScenarioNetwork, PaperEdgesSitWhereTheSpecPutsThem) {
 TEST(ScenarioNetwork, PaperRoadLayoutHasThreeClustersWithRampsAndExits) {
   const std::string net = palcas::sim::generateNetwork(RoadSpec{}, freshDir("layout_paper"));
   const RoadLayout road(palcas::sim::readNetEdges(net), 5, 800.0);
-  EXPECT_DOUBLE_EQ(road.mainlineLengthM(), 2400.0);  // 3 clusters x 800 m
-  ASSERT_EQ(road.clusters().size(), 3u);
-  for (int k = 0; k < 3; ++k) {
-    const auto& c = road.clusters()[k];
-    const double b = 800.0 * k;
-    EXPECT_DOUBLE_EQ(c.x_start_m, b);
-    EXPECT_DOUBLE_EQ(c.x_end_m, b + 800.0);
-    EXPECT_EQ(c.on_ramp_edge, "on_" + std::to_string(k));
-    EXPECT_EQ(c.merge_edge, "main_" + std::to_string(k) + "_merge");
-    EXPECT_NEAR(c.accel_lane_x_start_m, b + 150.0, 0.01);
-    EXPECT_NEAR(c.accel_lane_length_m, 250.0, 0.01);  // 400 - 150
-    EXPECT_EQ(c.off_ramp_edge, "off_" + std::to_string(k));
-    EXPECT_NEAR(c.exit_x_m, b + 700.0, 0.01);
-    EXPECT_LT(c.accel_lane_x_start_m + c.accel_lane_length_m, c.exit_x_m);  // merge before exit
-  }
+  expectClustersOfSpec(road, RoadSpec{});
   // The merge edge's SUMO lane 0 is the acceleration lane (paper lane 0), lane 1 the exit lane.
   EXPECT_EQ(road.paperLane("main_1_merge", 0), 0);
   EXPECT_EQ(road.paperLane("main_1_mid", 0), 1);
