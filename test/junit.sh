@@ -4,8 +4,10 @@
 # ("" as FILE writes nothing). Prints the failure count.
 
 junit_escape() {
-  local s="${1//&/&amp;}"
-  s="${s//</&lt;}"; s="${s//>/&gt;}"; s="${s//\"/&quot;}"
+  # bash 5.2 (patsub_replacement) reads a bare & in a replacement as the matched text:
+  # escape it, or "&quot;" comes out as '"quot;' and the XML is not well-formed.
+  local s="${1//&/\&amp;}"
+  s="${s//</\&lt;}"; s="${s//>/\&gt;}"; s="${s//\"/\&quot;}"
   printf '%s' "${s//$'\n'/ }"
 }
 

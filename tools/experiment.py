@@ -72,9 +72,10 @@ def training_seeds(policy_dir):
 
 
 def state_size(scenario):
+    """40 + the road's lane count (road/num_lanes of the scenario's scenario.yaml)."""
     import yaml
-    f = ROOT / "config" / "scenarios" / scenario / "learning.yaml"
-    return yaml.safe_load(f.read_text())["learning"]["state_size"]
+    f = ROOT / "config" / "scenarios" / scenario / "scenario.yaml"
+    return 40 + int(yaml.safe_load(f.read_text())["road"]["num_lanes"])
 
 
 def settings_from_args(a):
