@@ -37,6 +37,28 @@ elif ! grep -q "this RSU's zone is \[.*) m but zone [01] of the bridge's road is
 fi
 result train_refuses_zones_not_on_the_road "$why"
 
+# A corrupt checkpoint: --resume fails, naming the file and what is wrong with it (and the
+# file is left as it was, for the user to look at).
+status=0
+PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 30 \
+  --learning "$ROOT/config/training/tiny_fast_learning.yaml" --out "$WORK/train_ckpt" >"$WORK/ckpt1.log" 2>&1 || status=$?
+why=""
+if [ "$status" -ne 0 ] || [ ! -f "$WORK/train_ckpt/checkpoints/rsu_0/agent.ckpt" ]; then
+  why="the first training failed or wrote no checkpoint (exit $status): $(tail -2 "$WORK/ckpt1.log")"
+else
+  printf 'not a checkpoint' >"$WORK/train_ckpt/checkpoints/rsu_0/agent.ckpt"
+  status=0
+  PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --resume --episodes 2 --out "$WORK/train_ckpt" \
+    >"$WORK/ckpt2.log" 2>"$WORK/ckpt2_err.log" || status=$?
+  if [ "$status" -eq 0 ]; then why="--resume over a corrupt checkpoint exited 0"
+  elif ! grep -q "train_ckpt/checkpoints/rsu_0/agent.ckpt is not a PALCAS model file" "$WORK/ckpt2_err.log"; then
+    why="the error does not name the file and the fault: $(cat "$WORK/ckpt2_err.log")"
+  elif [ "$(cat "$WORK/train_ckpt/checkpoints/rsu_0/agent.ckpt")" != "not a checkpoint" ]; then
+    why="the corrupt checkpoint was overwritten"
+  fi
+fi
+result resume_refuses_a_corrupt_checkpoint "$why"
+
 # SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
 # process it started and says so; a training's nodes checkpoint on the way out.
 left_of() {  # DIR: processes whose command line names DIR
