@@ -2,10 +2,14 @@
 """Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
-usage: ship_policy.py [--rsu-models] TRAIN_DIR DEST_DIR
+usage: ship_policy.py [--rsu-models] [--bridge-as-trained] TRAIN_DIR DEST_DIR
 
 --rsu-models: ship each RSU's own final model (checkpoints/<rsu>/model.palcas: the last
 global model it loaded plus its local steps since) instead of the server's global model.
+--bridge-as-trained: the policy runs under the bridge parameters it was trained with: the
+training's --bridge-params file is copied as DEST_DIR/bridge.yaml, which `./palcas run`
+loads for the policy's arm (after config/bridge.yaml, before a --bridge-params of its own).
+Without it a policy runs under config/bridge.yaml, whatever it was trained under.
 
 DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
 checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
@@ -17,10 +21,16 @@ import shutil
 import sys
 
 
-def main(train_dir, dest, rsu_models=False):
+def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = json.loads((src / "train.json").read_text())
+    bridge = train.get("bridge_params", "")
+    if bridge_as_trained and not bridge:
+        sys.exit(f"--bridge-as-trained: {src} was trained under config/bridge.yaml alone "
+                 "(no --bridge-params); nothing to carry")
+    if bridge_as_trained and not pathlib.Path(bridge).is_file():
+        sys.exit(f"--bridge-as-trained: the training's bridge parameters {bridge} are gone")
     if dst.exists():
         shutil.rmtree(dst)
     (dst / "checkpoints").mkdir(parents=True)
@@ -45,6 +55,9 @@ def main(train_dir, dest, rsu_models=False):
     if learning:  # the override travels with the policy, referred to by its file name
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name
+    if bridge_as_trained:
+        shutil.copy2(bridge, dst / "bridge.yaml")
+        train["runs_with_bridge"] = "bridge.yaml"
     train["shipped_from"] = src.name
     train["shipped_models"] = "rsu" if rsu_models or not global_model.exists() else "global"
     (dst / "train.json").write_text(json.dumps(train) + "\n")
@@ -71,6 +84,10 @@ def main(train_dir, dest, rsu_models=False):
         ("- models: each RSU's own final model, `checkpoints/<rsu>/model.palcas` (its zone's RSU loads it)"
          if train["shipped_models"] == "rsu" else
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
+        ("- runs under the bridge parameters it was trained with: `bridge.yaml` (over config/bridge.yaml)"
+         if bridge_as_trained else
+         "- runs under config/bridge.yaml (trained under "
+         + (f"`{pathlib.Path(bridge).name}` over it" if bridge else "it") + ")"),
         "- files: "
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
@@ -80,7 +97,9 @@ def main(train_dir, dest, rsu_models=False):
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--rsu-models"]
-    if len(args) != 2:
+    flags = {"--rsu-models", "--bridge-as-trained"}
+    args = [a for a in sys.argv[1:] if a not in flags]
+    if len(args) != 2 or any(a.startswith("--") for a in args):
         sys.exit(__doc__)
-    main(args[0], args[1], rsu_models="--rsu-models" in sys.argv[1:])
+    main(args[0], args[1], rsu_models="--rsu-models" in sys.argv[1:],
+         bridge_as_trained="--bridge-as-trained" in sys.argv[1:])

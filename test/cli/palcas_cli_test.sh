@@ -68,6 +68,13 @@ check train_episodes_zero      "--episodes '0'"             train --out "$OUT" -
 check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed
 check train_explore_fraction_zero "--explore-fraction '0'" train --out "$OUT" --explore-fraction 0
 check run_scenario_wrong_state "its state has 43 features"  run --out "$OUT" --scenario tiny
+# A policy folder whose bridge.yaml is not a mapping of bridge parameters.
+BAD_BRIDGE="$WORK/bad_bridge_policy"
+mkdir -p "$BAD_BRIDGE"
+cp -r "$ROOT/config/policies/palcas/checkpoints" "$ROOT/config/policies/palcas/train.json" \
+  "$ROOT/config/policies/palcas/learning_schedule.yaml" "$BAD_BRIDGE/"
+printf -- '- not a mapping\n' >"$BAD_BRIDGE/bridge.yaml"
+check run_policy_bridge_not_a_mapping "its bridge.yaml is not a YAML mapping" run --out "$OUT" --policy "$BAD_BRIDGE"
 check train_bridge_params_missing "--bridge-params '/nonexistent'" train --out "$OUT" --bridge-params /nonexistent
 check experiment_arm_unknown   "--arms: unknown arm 'bogus'" experiment --out "$OUT" --arms keep,bogus
 check experiment_pr_out_of_range "--prs: 150 is outside"    experiment --out "$OUT" --arms keep --prs 5,150

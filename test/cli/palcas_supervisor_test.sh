@@ -46,6 +46,24 @@ why=""
 if [ "$status" -ne 0 ] || [ ! -f "$WORK/train_ckpt/checkpoints/rsu_0/agent.ckpt" ]; then
   why="the first training failed or wrote no checkpoint (exit $status): $(tail -2 "$WORK/ckpt1.log")"
 else
+  # First, as a policy: one whose folder carries bridge.yaml runs under it (what
+  # tools/ship_policy.py --bridge-as-trained writes), and --bridge-params still goes over it.
+  cp -r "$WORK/train_ckpt" "$WORK/policy_own_bridge"
+  printf 'cav_lane_change_mode: 1792\nlane_change_duration_s: 3.0\n' >"$WORK/policy_own_bridge/bridge.yaml"
+  printf 'lane_change_duration_s: 2.5\n' >"$WORK/user_bridge.yaml"
+  status=0
+  PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" run --policy "$WORK/policy_own_bridge" --no-compare \
+    --duration 20 --bridge-params "$WORK/user_bridge.yaml" --out "$WORK/run_own_bridge" >"$WORK/own_bridge.log" 2>&1 || status=$?
+  own="$(/usr/bin/python3 -c 'import json,sys; b=json.load(open(sys.argv[1]))["config"]["bridge"]; print(b["cav_lane_change_mode"], b["lane_change_duration_s"])' \
+         "$WORK/run_own_bridge/palcas/manifest.json" 2>&1)"
+  why=""
+  if [ "$status" -ne 0 ]; then why="the run failed (exit $status): $(tail -3 "$WORK/own_bridge.log")"
+  elif [ "$own" != "1792 2.5" ]; then why="the bridge ran with lane-change mode and duration '$own', expected '1792 2.5'"
+  elif ! grep -q "under the policy's own bridge parameters .*policy_own_bridge/bridge.yaml" "$WORK/own_bridge.log"; then
+    why="the run does not say it uses the policy's bridge.yaml"
+  fi
+  result run_uses_the_policys_own_bridge_parameters "$why"
+  why=""
   printf 'not a checkpoint' >"$WORK/train_ckpt/checkpoints/rsu_0/agent.ckpt"
   status=0
   PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --resume --episodes 2 --out "$WORK/train_ckpt" \

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tests of tools/train.py (./palcas train's orchestration) without a simulation: the
 options a resumed training settles on, the training record, and how a console log is read
-(nodes that died for good, why a simulation ended early).
+(nodes that died for good, why a simulation ended early); and of tools/ship_policy.py.
 
 usage: train_tool_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
 import json
@@ -14,6 +14,7 @@ import unittest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import ship_policy  # noqa: E402
 import train  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -154,6 +155,51 @@ class ScenarioFiles(unittest.TestCase):
         text = (ROOT / "config/scenarios/tiny/scenario.yaml").read_text()
         (folder / "scenario.yaml").write_text(text.replace("clusters: 2", "clusters: 4", 1))
         self.assertEqual(self.launch_rsu_count(str(folder)), 4)
+
+
+class ShipPolicy(unittest.TestCase):
+    """A training folder becomes a policy folder; its bridge parameters travel only when asked."""
+
+    def training(self, bridge_params):
+        src = pathlib.Path(tempfile.mkdtemp()) / "train-x"
+        (src / "checkpoints/rsu_0").mkdir(parents=True)
+        (src / "checkpoints/rsu_0/model.palcas").write_bytes(b"model")
+        record = dict(RECORD, arm="palcas", bridge_params=bridge_params, learning="")
+        (src / "train.json").write_text(json.dumps(record))
+        (src / "episodes.csv").write_text("episode,seed,sim_seconds,wall_seconds\n0,3,300,30\n")
+        return src
+
+    def test_bridge_as_trained_carries_the_trainings_bridge_parameters(self):
+        bridge = pathlib.Path(tempfile.mkdtemp()) / "lc.yaml"
+        bridge.write_text("cav_lane_change_mode: 1792\n")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(self.training(str(bridge))), str(dest), rsu_models=True, bridge_as_trained=True)
+        self.assertEqual((dest / "bridge.yaml").read_text(), "cav_lane_change_mode: 1792\n")
+        self.assertEqual(json.loads((dest / "train.json").read_text())["runs_with_bridge"], "bridge.yaml")
+        self.assertIn("trained with: `bridge.yaml`", (dest / "TRAINING.md").read_text())
+
+    def test_without_the_flag_a_policy_runs_under_the_default_bridge(self):
+        bridge = pathlib.Path(tempfile.mkdtemp()) / "unclipped.yaml"
+        bridge.write_text("max_advised_accel_mps2: 0.0\n")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(self.training(str(bridge))), str(dest), rsu_models=True)
+        self.assertFalse((dest / "bridge.yaml").exists())
+        self.assertNotIn("runs_with_bridge", json.loads((dest / "train.json").read_text()))
+        self.assertIn("runs under config/bridge.yaml (trained under `unclipped.yaml` over it)",
+                      (dest / "TRAINING.md").read_text())
+
+    def test_bridge_as_trained_without_bridge_parameters_is_refused_and_touches_nothing(self):
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        dest.mkdir()
+        (dest / "kept").write_text("x")
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(self.training("")), str(dest), bridge_as_trained=True)
+        self.assertIn("no --bridge-params", str(e.exception.code))
+        self.assertTrue((dest / "kept").exists())
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(self.training("/nonexistent/lc.yaml")), str(dest), bridge_as_trained=True)
+        self.assertIn("/nonexistent/lc.yaml are gone", str(e.exception.code))
+        self.assertTrue((dest / "kept").exists())
 
 
 if __name__ == "__main__":
