@@ -105,8 +105,10 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.remove_collided = p.get<bool>("remove_collided", o.session.remove_collided);
   o.session.cav_max_accel_mps2 = p.number("cav_max_accel_mps2", o.session.cav_max_accel_mps2, 0.0, 20.0);
   o.session.cav_max_decel_mps2 = p.number("cav_max_decel_mps2", o.session.cav_max_decel_mps2, 0.0, 20.0);
-  o.session.comfortable_lane_changes =
-      p.get<bool>("comfortable_lane_changes", o.session.comfortable_lane_changes);
+  o.session.lane_change_max_accel_mps2 =
+      p.number("lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2, 0.0, 20.0);
+  o.session.lane_change_max_decel_mps2 =
+      p.number("lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2, 0.0, 20.0);
   o.session.cluster_length_m = o.scenario.road.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
   o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);

@@ -436,20 +436,21 @@ bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
   return left_m >= v.speed_mps * time_s + v.length_m + 1.0;
 }
 
-void SumoSession::beginComfortableLaneChange(VehicleRecord& v) {
-  const double limit = options_.max_advised_accel_mps2;
-  if (!options_.comfortable_lane_changes || limit <= 0.0 || v.own_decel_mps2 > 0.0) return;
+void SumoSession::boundLaneChangeAcceleration(VehicleRecord& v) {
+  const double accel = options_.lane_change_max_accel_mps2, decel = options_.lane_change_max_decel_mps2;
+  if ((accel <= 0.0 && decel <= 0.0) || v.lane_change_bounded) return;
   v.own_accel_mps2 = api::Vehicle::getAccel(v.id);
   v.own_decel_mps2 = api::Vehicle::getDecel(v.id);
-  api::Vehicle::setAccel(v.id, std::min(limit, v.own_accel_mps2));
-  api::Vehicle::setDecel(v.id, std::min(limit, v.own_decel_mps2));
+  if (accel > 0.0) api::Vehicle::setAccel(v.id, std::min(accel, v.own_accel_mps2));
+  if (decel > 0.0) api::Vehicle::setDecel(v.id, std::min(decel, v.own_decel_mps2));
+  v.lane_change_bounded = true;
 }
 
-void SumoSession::endComfortableLaneChange(VehicleRecord& v) {
-  if (v.own_decel_mps2 <= 0.0) return;
+void SumoSession::restoreLaneChangeAcceleration(VehicleRecord& v) {
+  if (!v.lane_change_bounded) return;
   api::Vehicle::setAccel(v.id, v.own_accel_mps2);
   api::Vehicle::setDecel(v.id, v.own_decel_mps2);
-  v.own_accel_mps2 = v.own_decel_mps2 = 0.0;
+  v.lane_change_bounded = false;
 }
 
 void SumoSession::continueLaneChange(VehicleRecord& v) {
@@ -457,7 +458,7 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
     // Done, or dropped after lane_change_duration_s (no safe gap found in time).
     ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
     v.lane_change_target = 0;
-    endComfortableLaneChange(v);
+    restoreLaneChangeAcceleration(v);
     return;
   }
   if (v.edge != v.lane_change_edge && wholeOnEdge(v))
@@ -476,7 +477,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
                                   "' has no lane " + std::to_string(target_lane));
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
-    beginComfortableLaneChange(v);
+    boundLaneChangeAcceleration(v);
     // On a junction, or with its back still on one, the request waits until the vehicle is
     // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();

@@ -1,14 +1,14 @@
 // The SUMO session on the tiny road, in-process: an advised lane change happens within its
-// 2 s, and advisories the session cannot apply are refused. One libsumo simulation per
+// 2 s under its acceleration bounds, and advisories the session cannot apply are refused. One libsumo simulation per
 // process: one test. (Lane changes asked for while a CAV's back is still on a junction,
 // which aborted SUMO 1.15, are covered by palcas_tests/training_smoke.test, the run that
 // reproduced it.)
 #include "palcas_sim/sumo_session.h"
 
 #include <gtest/gtest.h>
+#include <libsumo/libsumo.h>
 
 #include <cmath>
-
 
 #include "palcas_sim/scenario.h"
 #include "scenario_test_util.h"
@@ -49,7 +49,10 @@ bool leftLaneFree(const SumoSession& session, const VehicleRecord& ego) {
 }  // namespace
 
 TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
-  SumoSession session(tinyOptions());
+  SessionOptions options = tinyOptions();
+  options.lane_change_max_accel_mps2 = 1.0;  // bounds while an advised change runs
+  options.lane_change_max_decel_mps2 = 3.0;
+  SumoSession session(options);
   ASSERT_EQ(session.road().numMainLanes(), 3);
 
   // 1. An advised lane change happens within the 2 s budget.
@@ -64,13 +67,24 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
         mover = v.id;
   }
   ASSERT_FALSE(mover.empty()) << "no moving CAV on lane 1";
+  const double own_accel = libsumo::Vehicle::getAccel(mover), own_decel = libsumo::Vehicle::getDecel(mover);
+  ASSERT_GT(own_accel, 1.0);
+  ASSERT_GT(own_decel, 3.0);
   session.applyAdvisory(mover, LANE_LEFT, 0.0);
-  for (int i = 0; i < 25 && session.find(mover); ++i) {
+  EXPECT_DOUBLE_EQ(libsumo::Vehicle::getAccel(mover), 1.0);
+  EXPECT_DOUBLE_EQ(libsumo::Vehicle::getDecel(mover), 3.0);
+  for (int i = 0; i < 25 && session.find(mover) && !changed; ++i) {
     session.step();
-    changed = changed || (session.find(mover) && session.find(mover)->lane == 2);
+    if (!session.find(mover)) break;
+    changed = session.find(mover)->lane == 2;
+    if (!changed) EXPECT_LE(session.find(mover)->accel_mps2, 1.0 + 1e-9) << "step " << i;
   }
   EXPECT_TRUE(changed) << mover << " did not reach lane 2 within 2.5 s";
   EXPECT_GE(session.laneChangesDone(), 1u);
+  session.step();  // the change is seen done: the vehicle's own limits come back
+  ASSERT_NE(session.find(mover), nullptr);
+  EXPECT_DOUBLE_EQ(libsumo::Vehicle::getAccel(mover), own_accel);
+  EXPECT_DOUBLE_EQ(libsumo::Vehicle::getDecel(mover), own_decel);
 
   // 2. Own car following: ACCELERATE brakes for its hold; once the command ends the CAV's
   // own model speeds it up again (a frozen speed would stay where the braking left it).

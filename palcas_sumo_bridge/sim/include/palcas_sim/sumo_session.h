@@ -61,10 +61,13 @@ struct SessionOptions {
   /// stays possible (SUMO's emergencyDecel).
   double cav_max_accel_mps2 = 0.0;
   double cav_max_decel_mps2 = 0.0;
-  /// true: while an advised lane change is under way, the CAV's acceleration and
-  /// deceleration are bounded by max_advised_accel_mps2 (SUMO's lane-change model adapts
-  /// the speed to make the gap within the comfort band), restored when it ends.
-  bool comfortable_lane_changes = false;
+  /// A CAV's largest acceleration / deceleration while an advised lane change is under way
+  /// [m/s^2] (SUMO's accel / decel of the vehicle, restored when the change is done or
+  /// dropped); 0 = its own. The lane-change model speeds up or brakes to make the gap it was
+  /// asked to take, at up to the vehicle's limits. SUMO's car following also plans its safe
+  /// gap with decel, so a small decel bound makes the CAV drop far back while it changes.
+  double lane_change_max_accel_mps2 = 0.0;
+  double lane_change_max_decel_mps2 = 0.0;
 };
 
 /// One vehicle on the road, updated every step.
@@ -110,7 +113,8 @@ struct VehicleRecord {
   int lane_change_target = 0;       ///< paper lane, 0 = none
   double lane_change_until_s = 0.0; ///< simulation time the request expires
   std::string lane_change_edge;     ///< edge the request was last issued on
-  /// The vehicle's own accel / decel while comfortable_lane_changes bounds them (0 = not bounded).
+  /// The vehicle's own accel / decel while an advised change bounds them (restored after).
+  bool lane_change_bounded = false;
   double own_accel_mps2 = 0.0, own_decel_mps2 = 0.0;
 };
 
@@ -185,9 +189,9 @@ class SumoSession {
   void updateDerived(VehicleRecord& v) const;
   void manageExit(VehicleRecord& v);
   void continueLaneChange(VehicleRecord& v);
-  /// comfortable_lane_changes: bound accel/decel for the advised change, then restore them.
-  void beginComfortableLaneChange(VehicleRecord& v);
-  void endComfortableLaneChange(VehicleRecord& v);
+  /// lane_change_max_{accel,decel}_mps2: bound them for the advised change, then restore.
+  void boundLaneChangeAcceleration(VehicleRecord& v);
+  void restoreLaneChangeAcceleration(VehicleRecord& v);
   bool wholeOnEdge(const VehicleRecord& v) const;
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
