@@ -2,14 +2,16 @@
 """Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
-usage: ship_policy.py [--rsu-models] [--bridge-as-trained] TRAIN_DIR DEST_DIR
+usage: ship_policy.py [--rsu-models] [--bridge-as-trained | --run-with-bridge FILE] TRAIN_DIR DEST_DIR
 
 --rsu-models: ship each RSU's own final model (checkpoints/<rsu>/model.palcas: the last
 global model it loaded plus its local steps since) instead of the server's global model.
 --bridge-as-trained: the policy runs under the bridge parameters it was trained with: the
 training's --bridge-params file is copied as DEST_DIR/bridge.yaml, which `./palcas run`
 loads for the policy's arm (after config/bridge.yaml, before a --bridge-params of its own).
-Without it a policy runs under config/bridge.yaml, whatever it was trained under.
+--run-with-bridge FILE: the policy runs under FILE's bridge parameters (copied as
+bridge.yaml) although it was not trained under them; TRAINING.md says so.
+Without either a policy runs under config/bridge.yaml, whatever it was trained under.
 
 DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
 checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
@@ -21,7 +23,7 @@ import shutil
 import sys
 
 
-def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
+def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = json.loads((src / "train.json").read_text())
@@ -31,6 +33,9 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
                  "(no --bridge-params); nothing to carry")
     if bridge_as_trained and not pathlib.Path(bridge).is_file():
         sys.exit(f"--bridge-as-trained: the training's bridge parameters {bridge} are gone")
+    if run_bridge and not pathlib.Path(run_bridge).is_file():
+        sys.exit(f"--run-with-bridge: no such file {run_bridge}")
+    run_bridge = run_bridge or (bridge if bridge_as_trained else None)
     if dst.exists():
         shutil.rmtree(dst)
     (dst / "checkpoints").mkdir(parents=True)
@@ -55,8 +60,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
     if learning:  # the override travels with the policy, referred to by its file name
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name
-    if bridge_as_trained:
-        shutil.copy2(bridge, dst / "bridge.yaml")
+    if run_bridge:
+        shutil.copy2(run_bridge, dst / "bridge.yaml")
         train["runs_with_bridge"] = "bridge.yaml"
     train["shipped_from"] = src.name
     train["shipped_models"] = "rsu" if rsu_models or not global_model.exists() else "global"
@@ -86,6 +91,9 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
         ("- runs under the bridge parameters it was trained with: `bridge.yaml` (over config/bridge.yaml)"
          if bridge_as_trained else
+         "- runs under the bridge parameters in `bridge.yaml` (over config/bridge.yaml), which its training "
+         "did not use (trained under " + (f"`{pathlib.Path(bridge).name}` over " if bridge else "") + "config/bridge.yaml)"
+         if run_bridge else
          "- runs under config/bridge.yaml (trained under "
          + (f"`{pathlib.Path(bridge).name}` over it" if bridge else "it") + ")"),
         "- files: "
@@ -98,8 +106,16 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False):
 
 if __name__ == "__main__":
     flags = {"--rsu-models", "--bridge-as-trained"}
-    args = [a for a in sys.argv[1:] if a not in flags]
+    argv = sys.argv[1:]
+    run_bridge = None
+    if "--run-with-bridge" in argv:
+        i = argv.index("--run-with-bridge")
+        if i + 1 >= len(argv) or "--bridge-as-trained" in argv:
+            sys.exit(__doc__)
+        run_bridge = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    args = [a for a in argv if a not in flags]
     if len(args) != 2 or any(a.startswith("--") for a in args):
         sys.exit(__doc__)
-    main(args[0], args[1], rsu_models="--rsu-models" in sys.argv[1:],
-         bridge_as_trained="--bridge-as-trained" in sys.argv[1:])
+    main(args[0], args[1], rsu_models="--rsu-models" in argv,
+         bridge_as_trained="--bridge-as-trained" in argv, run_bridge=run_bridge)

@@ -188,6 +188,19 @@ class ShipPolicy(unittest.TestCase):
         self.assertIn("runs under config/bridge.yaml (trained under `unclipped.yaml` over it)",
                       (dest / "TRAINING.md").read_text())
 
+    def test_run_with_bridge_carries_a_file_the_training_did_not_use_and_says_so(self):
+        bridge = pathlib.Path(tempfile.mkdtemp()) / "gentle.yaml"
+        bridge.write_text("lane_change_max_accel_mps2: 1.47\n")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(self.training("")), str(dest), rsu_models=True, run_bridge=str(bridge))
+        self.assertEqual((dest / "bridge.yaml").read_text(), "lane_change_max_accel_mps2: 1.47\n")
+        self.assertIn("which its training did not use (trained under config/bridge.yaml)",
+                      (dest / "TRAINING.md").read_text())
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(self.training("")), str(dest), run_bridge="/nonexistent.yaml")
+        self.assertIn("no such file /nonexistent.yaml", str(e.exception.code))
+        self.assertTrue((dest / "bridge.yaml").exists())  # the folder shipped before is kept
+
     def test_bridge_as_trained_without_bridge_parameters_is_refused_and_touches_nothing(self):
         dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
         dest.mkdir()
