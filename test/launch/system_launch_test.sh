@@ -39,6 +39,27 @@ params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep out_dir:
 names+=(arm_parameters); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameters: $why"; fi
 
+# paper_printed:=true gives the bridge the paper's literal actuation: none of the comfort
+# bounds of config/bridge.yaml, advised changes that avoid only immediate collisions. And a
+# policy's own bridge.yaml (policy_bridge_params) is loaded over config, under bridge_params.
+why=""
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas paper_printed:=true out_dir:=/tmp/unused 2>&1)"
+for expected in 'own_car_following: false' 'own_merge: false' 'max_advised_accel_mps2: 0.0' \
+                'lane_change_max_accel_mps2: 0.0' 'cav_lane_change_mode: 256'; do
+  grep -q "^/palcas_sumo_bridge/$expected\$" <<<"$params" || why="$why paper_printed lacks '$expected';"
+done
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused 2>&1)"
+grep -q '^/palcas_sumo_bridge/lane_change_max_accel_mps2: 1.47$' <<<"$params" || why="$why the default is not config/bridge.yaml's 1.47;"
+printf 'lane_change_max_accel_mps2: 2.0\nlane_change_duration_s: 3.0\n' >/tmp/palcas_policy_bridge_$$.yaml
+printf 'lane_change_duration_s: 2.5\n' >/tmp/palcas_user_bridge_$$.yaml
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused \
+          policy_bridge_params:=/tmp/palcas_policy_bridge_$$.yaml bridge_params:=/tmp/palcas_user_bridge_$$.yaml 2>&1)"
+rm -f /tmp/palcas_policy_bridge_$$.yaml /tmp/palcas_user_bridge_$$.yaml
+grep -q '^/palcas_sumo_bridge/lane_change_max_accel_mps2: 2.0$' <<<"$params" || why="$why the policy's bridge.yaml is not loaded;"
+grep -q '^/palcas_sumo_bridge/lane_change_duration_s: 2.5$' <<<"$params" || why="$why bridge_params does not go over the policy's;"
+names+=(bridge_parameter_layers); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   bridge_parameter_layers"; else echo "FAIL bridge_parameter_layers: $why"; fi
+
 why=""
 out="$(roslaunch --nodes palcas_launch system.launch arm:=bogus out_dir:=/tmp/unused 2>&1)" && why="an unknown arm was accepted"
 [ -n "$why" ] || [[ "$out" == *unknown_arm_bogus* ]] || why="the error does not name the arm: $out"
