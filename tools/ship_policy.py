@@ -23,6 +23,18 @@ import shutil
 import sys
 
 
+def bridge_line(trained_with, runs_with, as_trained):
+    """TRAINING.md's line on the bridge parameters the policy runs under."""
+    trained = (f"`{pathlib.Path(trained_with).name}` over " if trained_with else "") + "config/bridge.yaml"
+    if as_trained:
+        return "- runs under the bridge parameters it was trained with: `bridge.yaml` (over config/bridge.yaml)"
+    if runs_with:
+        return ("- runs under the bridge parameters in `bridge.yaml` (over config/bridge.yaml), which its "
+                f"training did not use (trained under {trained})")
+    return "- runs under config/bridge.yaml (trained under " + (
+        f"`{pathlib.Path(trained_with).name}` over it" if trained_with else "it") + ")"
+
+
 def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
@@ -89,13 +101,7 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         ("- models: each RSU's own final model, `checkpoints/<rsu>/model.palcas` (its zone's RSU loads it)"
          if train["shipped_models"] == "rsu" else
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
-        ("- runs under the bridge parameters it was trained with: `bridge.yaml` (over config/bridge.yaml)"
-         if bridge_as_trained else
-         "- runs under the bridge parameters in `bridge.yaml` (over config/bridge.yaml), which its training "
-         "did not use (trained under " + (f"`{pathlib.Path(bridge).name}` over " if bridge else "") + "config/bridge.yaml)"
-         if run_bridge else
-         "- runs under config/bridge.yaml (trained under "
-         + (f"`{pathlib.Path(bridge).name}` over it" if bridge else "it") + ")"),
+        bridge_line(bridge, run_bridge, bridge_as_trained),
         "- files: "
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
@@ -105,17 +111,14 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
 
 
 if __name__ == "__main__":
-    flags = {"--rsu-models", "--bridge-as-trained"}
-    argv = sys.argv[1:]
-    run_bridge = None
-    if "--run-with-bridge" in argv:
-        i = argv.index("--run-with-bridge")
-        if i + 1 >= len(argv) or "--bridge-as-trained" in argv:
-            sys.exit(__doc__)
-        run_bridge = argv[i + 1]
-        argv = argv[:i] + argv[i + 2:]
-    args = [a for a in argv if a not in flags]
-    if len(args) != 2 or any(a.startswith("--") for a in args):
-        sys.exit(__doc__)
-    main(args[0], args[1], rsu_models="--rsu-models" in argv,
-         bridge_as_trained="--bridge-as-trained" in argv, run_bridge=run_bridge)
+    import argparse
+    ap = argparse.ArgumentParser(usage=__doc__.split("\n\n")[1])
+    ap.add_argument("--rsu-models", action="store_true")
+    which = ap.add_mutually_exclusive_group()
+    which.add_argument("--bridge-as-trained", action="store_true")
+    which.add_argument("--run-with-bridge", metavar="FILE")
+    ap.add_argument("train_dir")
+    ap.add_argument("dest_dir")
+    a = ap.parse_args()
+    main(a.train_dir, a.dest_dir, rsu_models=a.rsu_models, bridge_as_trained=a.bridge_as_trained,
+         run_bridge=a.run_with_bridge)
