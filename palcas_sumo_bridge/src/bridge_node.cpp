@@ -379,6 +379,7 @@ void BridgeNode::runEpisode(int episode) {
   summary.lane_changes_dropped = session_->laneChangesDropped();
   summary.vanished_vehicles = session_->vanishedVehicles();
   summary.route_changes_failed = session_->routeChangesFailed();
+  summary.guard = session_->guardCounters();
   writeMetricsJson(options_, summary, episode);
   ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
            options_.first_episode + options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());

@@ -102,6 +102,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"max_advised_accel_mps2", o.session.max_advised_accel_mps2},
           {"lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2},
           {"lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2},
+          {"guard_floor_speed_share", o.session.guard_floor_speed_share},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
           {"cav_max_decel_mps2", o.session.cav_max_decel_mps2},
           {"remove_collided", o.session.remove_collided},
@@ -201,6 +202,20 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   return s;
 }
 
+// How often the advice guard acted: CAV seconds and the share of the time it covers.
+json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
+  const double dt = o.scenario.step_length_s;
+  auto share = [](std::uint64_t part, std::uint64_t whole) { return whole ? number(100.0 * part / whole) : json(nullptr); };
+  return {{"floor_speed_share", o.session.guard_floor_speed_share},
+          {"accelerate_cav_s", dt * g.accelerate_steps},
+          {"accelerate_floored_cav_s", dt * g.accelerate_floored_steps},
+          {"accelerate_released_cav_s", dt * g.accelerate_released_steps},
+          {"accelerate_guarded_pct", share(g.accelerate_floored_steps + g.accelerate_released_steps, g.accelerate_steps)},
+          {"lane_change_cav_s", dt * g.lane_change_steps},
+          {"lane_change_released_cav_s", dt * g.lane_change_released_steps},
+          {"lane_change_guarded_pct", share(g.lane_change_released_steps, g.lane_change_steps)}};
+}
+
 void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {
   const metrics::EpisodeMetrics& m = s.metrics;
   json timing = json::array();
@@ -233,6 +248,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"lane_changes_dropped", s.lane_changes_dropped},
               {"vanished_vehicles", s.vanished_vehicles},
               {"route_changes_failed", s.route_changes_failed},
+              {"guard", guardJson(o, s.guard)},
               {"late_rsu_steps", m.late_rsu_steps},
               {"decision_ms_p50", percentile(s.decision_ms, 50)},
               {"decision_ms_p90", percentile(s.decision_ms, 90)},

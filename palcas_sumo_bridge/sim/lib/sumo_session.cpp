@@ -461,8 +461,25 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
     restoreLaneChangeAcceleration(v);
     return;
   }
+  updateLaneChangeBound(v);
   if (v.edge != v.lane_change_edge && wholeOnEdge(v))
     requestLaneChange(v, v.lane_change_until_s - time_s_);
+}
+
+double SumoSession::guardFloorMps(const VehicleRecord& v) const {
+  if (options_.guard_floor_speed_share <= 0.0) return 0.0;
+  return options_.guard_floor_speed_share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
+}
+
+void SumoSession::updateLaneChangeBound(VehicleRecord& v) {
+  ++guard_.lane_change_steps;
+  if (options_.guard_floor_speed_share > 0.0 && v.speed_mps < guardFloorMps(v)) {
+    // Queued or slowed down: the change must not also hold back how fast it gets going.
+    ++guard_.lane_change_released_steps;
+    restoreLaneChangeAcceleration(v);
+    return;
+  }
+  boundLaneChangeAcceleration(v);
 }
 
 void SumoSession::applyAdvisory(const std::string& id, int action, double accel_mps2) {
@@ -477,7 +494,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
                                   "' has no lane " + std::to_string(target_lane));
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
-    boundLaneChangeAcceleration(v);
+    updateLaneChangeBound(v);
     // On a junction, or with its back still on one, the request waits until the vehicle is
     // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();
@@ -517,13 +534,30 @@ void SumoSession::applyHeldCommand(VehicleRecord& v) {
     v.command = HeldCommand::kNone;
     return;
   }
-  v.speed_overridden = true;
   if (v.command == HeldCommand::kKeepSpeed) {
+    v.speed_overridden = true;
     api::Vehicle::setSpeed(v.id, v.command_value);
-  } else {
-    // Holding an acceleration: aim each step at the speed it reaches in one step.
-    api::Vehicle::setSpeed(v.id, std::max(0.0, v.speed_mps + v.command_value * step_length_s_));
+    return;
   }
+  // Holding an acceleration: aim each step at the speed it reaches in one step. With the
+  // CAV's safe-speed check on (speed mode 31) that target only ever holds it below what its
+  // own car following would do, so the guard bounds how far: never below the floor.
+  ++guard_.accelerate_steps;
+  double target = std::max(0.0, v.speed_mps + v.command_value * step_length_s_);
+  const double floor = guardFloorMps(v);
+  if (target < floor) {
+    if (v.speed_mps < floor) {
+      // Already below it (queued, stopped, blocked): its own driving, at its own rate.
+      ++guard_.accelerate_released_steps;
+      if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
+      v.speed_overridden = false;
+      return;
+    }
+    ++guard_.accelerate_floored_steps;
+    target = floor;
+  }
+  v.speed_overridden = true;
+  api::Vehicle::setSpeed(v.id, target);
 }
 
 }  // namespace palcas::sim

@@ -10,6 +10,8 @@
 #include <string>
 
 #include "palcas_sim/road_spec.h"
+#include "palcas_sim/scenario.h"
+#include "palcas_sim/sumo_session.h"
 
 namespace palcas::sim::test {
 
@@ -51,6 +53,27 @@ inline std::string slurp(const std::string& path) {
   std::ostringstream out;
   out << in.rdbuf();
   return out.str();
+}
+
+// In-process session options on the tiny road with every vehicle a CAV (plenty of
+// candidates), advisory control and the actuation config/bridge.yaml ships.
+inline SessionOptions sessionOnTiny(const std::string& dir_name, unsigned seed = 3) {
+  ScenarioConfig c;
+  c.scenario_dir = scenarioDir("tiny");
+  c.road = tinyRoad();  // default route shares for its two clusters
+  c.penetration_rate = 1.0;
+  c.duration_s = 400.0;
+  c.seed = seed;
+  const auto files = writeScenario(c, freshDir(dir_name));
+  SessionOptions o;
+  o.sumo_args = {"-c", files.sumocfg_file, "--no-warnings", "true", "--no-step-log", "true",
+                 "--time-to-teleport.remove", "true"};
+  o.cluster_length_m = 300.0;
+  o.advisory_control = true;
+  o.own_car_following = true;
+  o.own_merge = true;
+  o.cav_lane_change_mode = 1536;
+  return o;
 }
 
 }  // namespace palcas::sim::test

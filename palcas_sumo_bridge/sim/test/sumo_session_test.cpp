@@ -22,21 +22,8 @@ namespace {
 constexpr int LANE_LEFT = 0, ACCELERATE = 2, KEEP = 3;
 
 SessionOptions tinyOptions() {
-  palcas::sim::ScenarioConfig c;
-  c.scenario_dir = palcas::sim::test::scenarioDir("tiny");
-  c.road = palcas::sim::test::tinyRoad();  // default route shares for its two clusters
-  c.penetration_rate = 1.0;  // every vehicle a CAV: plenty of candidates
-  c.duration_s = 400.0;
-  c.seed = 3;
-  const auto files = palcas::sim::writeScenario(c, palcas::sim::test::freshDir("session"));
-  SessionOptions o;
-  o.sumo_args = {"-c", files.sumocfg_file, "--no-warnings", "true", "--no-step-log", "true",
-                 "--time-to-teleport.remove", "true"};
-  o.cluster_length_m = 300.0;
-  o.advisory_control = true;
-  o.own_car_following = true;  // what config/bridge.yaml ships
-  o.own_merge = true;
-  o.cav_lane_change_mode = 1536;
+  SessionOptions o = palcas::sim::test::sessionOnTiny("session");
+  o.guard_floor_speed_share = 0.0;  // the actuation itself (advice_guard_test: with the guard)
   return o;
 }
 // The lane-change model checks the others' gaps (cav_lane_change_mode 1536): pick a CAV

@@ -68,6 +68,22 @@ struct SessionOptions {
   /// gap with decel, so a small decel bound makes the CAV drop far back while it changes.
   double lane_change_max_accel_mps2 = 0.0;
   double lane_change_max_decel_mps2 = 0.0;
+  /// The advice guard's speed floor, as a share of the CAV's allowed speed (its lane's limit,
+  /// or its own top speed if lower). Advice may slow a CAV down to the floor, never below:
+  /// an ACCELERATE that would take it lower stops at the floor, and a CAV already below it
+  /// (queued, stopped, blocked) drives itself, ACCELERATE commands and the advised-change
+  /// acceleration bound lifted, so it leaves a queue at its own car following's rate. 0 = off
+  /// (the paper: the advised acceleration always reaches the car).
+  double guard_floor_speed_share = 0.6;
+};
+
+/// How often the advice guard (SessionOptions::guard_floor_speed_share) acted, in CAV steps.
+struct GuardCounters {
+  std::uint64_t accelerate_steps = 0;         ///< CAV steps under an ACCELERATE command
+  std::uint64_t accelerate_floored_steps = 0; ///< ... held at the floor instead of the command
+  std::uint64_t accelerate_released_steps = 0;///< ... driven by its own model (below the floor)
+  std::uint64_t lane_change_steps = 0;        ///< CAV steps with an advised change under way
+  std::uint64_t lane_change_released_steps = 0;///< ... with the acceleration bound lifted
 };
 
 /// One vehicle on the road, updated every step.
@@ -176,6 +192,10 @@ class SumoSession {
   std::uint64_t vanishedVehicles() const { return vanished_vehicles_; }
   /// Exit commitments / withdrawals SUMO refused (the vehicle kept its route).
   std::uint64_t routeChangesFailed() const { return route_changes_failed_; }
+  /// How often the advice guard acted (all zero when it is off).
+  const GuardCounters& guardCounters() const { return guard_; }
+  /// The guard's floor for this CAV [m/s] (0 when the guard is off).
+  double guardFloorMps(const VehicleRecord& v) const;
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -192,6 +212,9 @@ class SumoSession {
   /// lane_change_max_{accel,decel}_mps2: bound them for the advised change, then restore.
   void boundLaneChangeAcceleration(VehicleRecord& v);
   void restoreLaneChangeAcceleration(VehicleRecord& v);
+  /// Bounds an advised change's acceleration while the CAV is above the guard's floor,
+  /// lifts the bound below it.
+  void updateLaneChangeBound(VehicleRecord& v);
   bool wholeOnEdge(const VehicleRecord& v) const;
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
@@ -214,6 +237,7 @@ class SumoSession {
   bool open_ = false;
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
   std::uint64_t route_changes_failed_ = 0;
+  GuardCounters guard_;
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
