@@ -2,10 +2,13 @@
 """Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
-usage: ship_policy.py [--rsu-models] [--bridge-as-trained | --run-with-bridge FILE] TRAIN_DIR DEST_DIR
+usage: ship_policy.py [--rsu-models] [--default-from RSU] [--bridge-as-trained | --run-with-bridge FILE] TRAIN_DIR DEST_DIR
 
 --rsu-models: ship each RSU's own final model (checkpoints/<rsu>/model.palcas: the last
-global model it loaded plus its local steps since) instead of the server's global model.
+global model it loaded plus its local steps since) instead of the server's global model, and
+the global model as checkpoints/default/model.palcas: the model an RSU of a zone the training
+did not have (a road with more clusters) starts from. --default-from RSU: without a global
+model (independent, centralized), that RSU's model is the default one.
 --bridge-as-trained: the policy runs under the bridge parameters it was trained with: the
 training's --bridge-params file is copied as DEST_DIR/bridge.yaml, which `./palcas run`
 loads for the policy's arm (after config/bridge.yaml, before a --bridge-params of its own).
@@ -35,7 +38,7 @@ def bridge_line(trained_with, runs_with, as_trained):
         f"`{pathlib.Path(trained_with).name}` over it" if trained_with else "it") + ")"
 
 
-def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None):
+def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None, default_from=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = json.loads((src / "train.json").read_text())
@@ -47,6 +50,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         sys.exit(f"--bridge-as-trained: the training's bridge parameters {bridge} are gone")
     if run_bridge and not pathlib.Path(run_bridge).is_file():
         sys.exit(f"--run-with-bridge: no such file {run_bridge}")
+    if default_from and not (src / "checkpoints" / default_from / "model.palcas").is_file():
+        sys.exit(f"--default-from: {src} holds no checkpoints/{default_from}/model.palcas")
     run_bridge = run_bridge or (bridge if bridge_as_trained else None)
     if dst.exists():
         shutil.rmtree(dst)
@@ -62,6 +67,12 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         for model in sorted(src.glob("checkpoints/*/model.palcas")):
             (dst / "checkpoints" / model.parent.name).mkdir()
             shutil.copy2(model, dst / "checkpoints" / model.parent.name)
+        default = global_model if global_model.exists() else (
+            src / "checkpoints" / default_from / "model.palcas" if default_from else None)
+        if default:  # for RSUs without a model of their own (palcas_rsu: the load order)
+            (dst / "checkpoints/default").mkdir(exist_ok=True)
+            shutil.copy2(default, dst / "checkpoints/default/model.palcas")
+            train["default_model"] = "global" if default == global_model else default_from
     for csv_file in sorted(src.glob("checkpoints/*/learning.csv")):
         (dst / "checkpoints" / csv_file.parent.name).mkdir(exist_ok=True)
         shutil.copy2(csv_file, dst / "checkpoints" / csv_file.parent.name)
@@ -99,6 +110,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         f"(real-time factor {sim_s / wall_s:.1f}x)",
         f"- episodes ended early and not counted: {len(aborted)}" + ("".join("\n  - " + a for a in aborted)),
         ("- models: each RSU's own final model, `checkpoints/<rsu>/model.palcas` (its zone's RSU loads it)"
+         + (f"; an RSU without one loads `checkpoints/default/model.palcas` ({train['default_model']}'s model)"
+            if train.get("default_model") else "; an RSU without one has no model to load")
          if train["shipped_models"] == "rsu" else
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
         bridge_line(bridge, run_bridge, bridge_as_trained),
@@ -114,6 +127,7 @@ if __name__ == "__main__":
     import argparse
     ap = argparse.ArgumentParser(usage=__doc__.split("\n\n")[1])
     ap.add_argument("--rsu-models", action="store_true")
+    ap.add_argument("--default-from", metavar="RSU")
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--bridge-as-trained", action="store_true")
     which.add_argument("--run-with-bridge", metavar="FILE")
@@ -121,4 +135,4 @@ if __name__ == "__main__":
     ap.add_argument("dest_dir")
     a = ap.parse_args()
     main(a.train_dir, a.dest_dir, rsu_models=a.rsu_models, bridge_as_trained=a.bridge_as_trained,
-         run_bridge=a.run_with_bridge)
+         run_bridge=a.run_with_bridge, default_from=a.default_from)

@@ -78,13 +78,19 @@ std::string RsuNode::checkpointDir() const {
 void RsuNode::loadInitialModel() {
   const RsuControllerOptions& c = options_.controller;
   if (!c.train && !options_.policy_dir.empty()) {
-    // A federated policy is the server's global model; an independent one is per RSU.
-    const fs::path global = fs::path(options_.policy_dir) / "fedserver" / "global_model.palcas";
-    const fs::path own = fs::path(options_.policy_dir) / c.rsu_id / "model.palcas";
-    const fs::path file = fs::exists(global) ? global : own;
-    if (!fs::exists(file))
-      throw std::runtime_error("policy_dir '" + options_.policy_dir + "' holds neither " +
-                               global.string() + " nor " + own.string());
+    // A federated policy is the server's global model; an independent one is per RSU; an RSU
+    // with no model of its own (a zone the training did not have) starts from the policy's
+    // default model, which tools/ship_policy.py ships beside per-RSU models.
+    const fs::path dir(options_.policy_dir);
+    const fs::path candidates[] = {dir / "fedserver" / "global_model.palcas", dir / c.rsu_id / "model.palcas",
+                                   dir / "default" / "model.palcas"};
+    const fs::path* found = nullptr;
+    for (const fs::path& f : candidates)
+      if (!found && fs::exists(f)) found = &f;
+    if (!found)
+      throw std::runtime_error("policy_dir '" + options_.policy_dir + "' holds none of " + candidates[0].string() +
+                               ", " + candidates[1].string() + ", " + candidates[2].string());
+    const fs::path file = *found;
     controller_->loadPolicy(file.string());
     ROS_INFO("%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
     return;

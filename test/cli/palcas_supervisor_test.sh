@@ -37,6 +37,27 @@ elif ! grep -q "this RSU's zone is \[.*) m but zone [01] of the bridge's road is
 fi
 result train_refuses_zones_not_on_the_road "$why"
 
+# The shipped policy on a road with twice its zones (--scenario takes an absolute folder): the
+# RSUs of zones the training had load their own models, the others the policy's default
+# model, and every RSU advises. 240 s: CAVs reach the last zone (x >= 4000 m) by then.
+mkdir -p "$WORK/paper6"
+sed 's/^  clusters: 3$/  clusters: 6/' "$ROOT/config/scenarios/paper/scenario.yaml" >"$WORK/paper6/scenario.yaml"
+cp "$ROOT/config/scenarios/paper/vtypes.xml" "$WORK/paper6/"
+status=0
+PALCAS_NO_BUILD=1 timeout -k 10 600 "$ROOT/palcas" run --scenario "$WORK/paper6" --no-compare --duration 240 \
+  --seed 104 --out "$WORK/six" >"$WORK/six.log" 2>&1 || status=$?
+why=""
+if [ "$status" -ne 0 ]; then why="exit $status: $(tail -3 "$WORK/six.log")"
+elif ! grep -q 'clusters: 6' "$WORK/paper6/scenario.yaml"; then why="the test's road is not 6 clusters"
+elif ! grep -aq "rsu_0: evaluating policy .*/checkpoints/rsu_0/model.palcas" "$WORK/six/palcas/console.log"; then why="rsu_0 did not load its own model"
+elif ! grep -aq "rsu_5: evaluating policy .*/checkpoints/default/model.palcas" "$WORK/six/palcas/console.log"; then why="rsu_5 did not load the default model"
+elif ! /usr/bin/python3 -c 'import json,sys; m=json.load(open(sys.argv[1])); sys.exit(0 if m["sim_seconds"] >= 240 else 1)' "$WORK/six/palcas/metrics.json"; then
+  why="a short run: $(head -c 300 "$WORK/six/palcas/metrics.json")"
+elif [ "$(awk -F, 'NR > 1 && $4 > 0 { print $2 }' "$WORK/six/palcas/decisions.csv" | sort -u | tr '\n' ' ')" != "rsu_0 rsu_1 rsu_2 rsu_3 rsu_4 rsu_5 " ]; then
+  why="not every RSU advised: $(awk -F, 'NR > 1 && $4 > 0 { print $2 }' "$WORK/six/palcas/decisions.csv" | sort | uniq -c | tr '\n' ' ')"
+fi
+result shipped_policy_serves_a_road_with_six_zones "$why"
+
 # A corrupt checkpoint: --resume fails, naming the file and what is wrong with it (and the
 # file is left as it was, for the user to look at).
 status=0

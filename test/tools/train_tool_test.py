@@ -201,6 +201,27 @@ class ShipPolicy(unittest.TestCase):
         self.assertIn("no such file /nonexistent.yaml", str(e.exception.code))
         self.assertTrue((dest / "bridge.yaml").exists())  # the folder shipped before is kept
 
+    def test_rsu_models_ship_the_global_model_as_the_default_for_zones_without_their_own(self):
+        src = self.training("")
+        (src / "checkpoints/fedserver").mkdir()
+        (src / "checkpoints/fedserver/global_model.palcas").write_bytes(b"global")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(src), str(dest), rsu_models=True)
+        self.assertEqual((dest / "checkpoints/rsu_0/model.palcas").read_bytes(), b"model")
+        self.assertEqual((dest / "checkpoints/default/model.palcas").read_bytes(), b"global")
+        self.assertFalse((dest / "checkpoints/fedserver/global_model.palcas").exists())
+        self.assertEqual(json.loads((dest / "train.json").read_text())["default_model"], "global")
+        self.assertIn("an RSU without one loads `checkpoints/default/model.palcas`", (dest / "TRAINING.md").read_text())
+
+    def test_default_from_names_the_rsu_whose_model_is_the_default_and_must_exist(self):
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(self.training("")), str(dest), rsu_models=True, default_from="rsu_0")
+        self.assertEqual((dest / "checkpoints/default/model.palcas").read_bytes(), b"model")
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(self.training("")), str(dest), rsu_models=True, default_from="rsu_7")
+        self.assertIn("no checkpoints/rsu_7/model.palcas", str(e.exception.code))
+        self.assertTrue((dest / "checkpoints/default/model.palcas").exists())  # kept
+
     def test_bridge_as_trained_without_bridge_parameters_is_refused_and_touches_nothing(self):
         dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
         dest.mkdir()
