@@ -24,7 +24,7 @@ METRICS = [
 EXTRA = ["efficiency_cav_mps", "decision_ms_p99", "lane_changes_dropped", "collisions",
          "teleports", "cavs_seen", "exiting_cavs", "merging_cavs", "sim_seconds",
          "wall_seconds", "real_time_factor"]
-ARM_TITLES = {"palcas": "PALCAS", "centralized": "Baseline-1 (centralized)",
+ARM_TITLES = {"palcas": "PALCAS", "palcas_assist": "PALCAS (assist mode)", "centralized": "Baseline-1 (centralized)",
               "independent": "Baseline-2 (independent)", "no_priority": "no priority (ablation)",
               "keep": "keep", "sumo_native": "SUMO-native"}
 

@@ -33,7 +33,7 @@ ROUTES = ("main_through", "main_exit", "ramp_through", "ramp_exit")
 ROUTE_TITLES = {"main_through": "mainline -> mainline", "main_exit": "mainline -> off-ramp",
                 "ramp_through": "on-ramp -> mainline", "ramp_exit": "on-ramp -> off-ramp"}
 ON_MAINLINE = ("mainline", "accel_lane")
-ARM_ORDER = ("palcas", "centralized", "independent", "no_priority", "keep", "sumo_native")
+ARM_ORDER = ("palcas", "palcas_assist", "centralized", "independent", "no_priority", "keep", "sumo_native")
 
 
 def arm_sort(arms):

@@ -111,6 +111,9 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
       p.number("lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2, 0.0, 20.0);
   o.session.guard_floor_speed_share =
       p.number("guard_floor_speed_share", o.session.guard_floor_speed_share, 0.0, 1.0);
+  o.session.assist_mode = p.get<bool>("assist_mode", o.session.assist_mode);
+  o.session.assist_lane_change_mode =
+      p.integer("assist_lane_change_mode", o.session.assist_lane_change_mode, 0, 4095);
   o.session.cluster_length_m = o.scenario.road.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
   o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);

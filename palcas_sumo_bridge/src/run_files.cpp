@@ -103,6 +103,8 @@ json bridgeJson(const BridgeOptions& o) {
           {"lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2},
           {"lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2},
           {"guard_floor_speed_share", o.session.guard_floor_speed_share},
+          {"assist_mode", o.session.assist_mode},
+          {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
           {"cav_max_decel_mps2", o.session.cav_max_decel_mps2},
           {"remove_collided", o.session.remove_collided},

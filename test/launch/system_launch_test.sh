@@ -25,6 +25,7 @@ expect_nodes() {  # ARM "NODES"
   if [ -z "$why" ]; then echo "ok   arm_$1"; else echo "FAIL arm_$1: $why"; fi
 }
 expect_nodes palcas "/fedserver/palcas_fedserver /palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
+expect_nodes palcas_assist "/fedserver/palcas_fedserver /palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
 expect_nodes no_priority "/fedserver/palcas_fedserver /palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
 expect_nodes independent "/palcas_sumo_bridge /rsu_0/rsu /rsu_1/rsu /rsu_2/rsu"
 expect_nodes centralized "/central/rsu /palcas_sumo_bridge"
@@ -36,6 +37,10 @@ params="$(roslaunch --dump-params palcas_launch system.launch arm:=no_priority o
 grep -q '^/rsu_0/rsu/reward/lambda: 0.0' <<<"$params" || why="no_priority does not set lambda 0"
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep out_dir:=/tmp/unused 2>&1)"
 [ -n "$why" ] || grep -q '^/palcas_sumo_bridge/advisory_control: true' <<<"$params" || why="keep without advisory control"
+[ -n "$why" ] || grep -q '^/palcas_sumo_bridge/assist_mode: false' <<<"$params" || why="keep in assist mode"
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas_assist out_dir:=/tmp/unused 2>&1)"
+[ -n "$why" ] || grep -q '^/palcas_sumo_bridge/assist_mode: true' <<<"$params" || why="palcas_assist not in assist mode"
+[ -n "$why" ] || grep -q '^/rsu_0/rsu/federation: true' <<<"$params" || why="palcas_assist without federation"
 names+=(arm_parameters); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameters: $why"; fi
 

@@ -300,12 +300,17 @@ void SumoSession::onDeparted(const std::string& id) {
   if (v.is_cav && options_.cav_max_decel_mps2 > 0.0) api::Vehicle::setDecel(id, options_.cav_max_decel_mps2);
   if (v.is_cav && options_.advisory_control) {
     api::Vehicle::setSpeedMode(id, options_.cav_speed_mode);
-    v.merge_mode = options_.own_merge && v.entry_cluster >= 0;  // ramp CAVs start on a ramp
-    api::Vehicle::setLaneChangeMode(id, options_.cav_lane_change_mode | (v.merge_mode ? 1 : 0));
-    // Controlled CAVs drive towards the mainline end; the bridge switches the target to the
-    // off-ramp only once the CAV is in lane 1 just before it, so a CAV that does not get
-    // there in time really misses its exit (SUMO's strategic changes are off).
-    if (v.exit_cluster >= 0 && !end_edge_.empty()) api::Vehicle::changeTarget(id, end_edge_);
+    if (options_.assist_mode) {
+      // Its own route (to its off-ramp) and its own lane changes; advice rides on top.
+      api::Vehicle::setLaneChangeMode(id, options_.assist_lane_change_mode);
+    } else {
+      v.merge_mode = options_.own_merge && v.entry_cluster >= 0;  // ramp CAVs start on a ramp
+      api::Vehicle::setLaneChangeMode(id, options_.cav_lane_change_mode | (v.merge_mode ? 1 : 0));
+      // Controlled CAVs drive towards the mainline end; the bridge switches the target to the
+      // off-ramp only once the CAV is in lane 1 just before it, so a CAV that does not get
+      // there in time really misses its exit (SUMO's strategic changes are off).
+      if (v.exit_cluster >= 0 && !end_edge_.empty()) api::Vehicle::changeTarget(id, end_edge_);
+    }
   }
   index_[id] = vehicles_.size();
   vehicles_.push_back(std::move(v));
@@ -333,7 +338,7 @@ void SumoSession::readVehicles() {
     v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
     updateDerived(v);
     if (v.lane_change_target != 0) continueLaneChange(v);
-    if (v.is_cav && options_.advisory_control) {
+    if (v.is_cav && options_.advisory_control && !options_.assist_mode) {
       manageExit(v);
       if (v.merge_mode) updateMergeMode(v);
     }

@@ -75,6 +75,17 @@ struct SessionOptions {
   /// acceleration bound lifted, so it leaves a queue at its own car following's rate. 0 = off
   /// (the paper: the advised acceleration always reaches the car).
   double guard_floor_speed_share = 0.6;
+  /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
+  /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
+  /// lane-change model makes its own strategic, cooperative and speed-gain changes
+  /// (assist_lane_change_mode); advisories ride on top (an advised change is a TraCI request,
+  /// which wins over the CAV's own changes for its lane_change_duration_s). false: only
+  /// advisories change lanes and the RSUs alone serve the exits (cav_lane_change_mode).
+  bool assist_mode = false;
+  /// SUMO lane-change-mode bits for CAVs in assist mode (1621 = SUMO's default: every change
+  /// of its own unless a TraCI request conflicts, requests respect the others' gaps, sublane
+  /// alignment).
+  int assist_lane_change_mode = 1621;
 };
 
 /// How often the advice guard (SessionOptions::guard_floor_speed_share) acted, in CAV steps.
