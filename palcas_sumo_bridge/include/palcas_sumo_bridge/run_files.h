@@ -51,6 +51,7 @@ struct RunSummary {
   std::uint64_t lane_changes_done = 0, lane_changes_dropped = 0;
   std::uint64_t vanished_vehicles = 0;  ///< tracked vehicles SUMO no longer knew
   std::uint64_t route_changes_failed = 0;  ///< exit route changes SUMO refused
+  std::uint64_t insertion_dropped = 0;  ///< vehicles SUMO dropped at insertion (max_depart_delay_s)
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

@@ -176,6 +176,9 @@ class SumoSession {
   std::uint64_t vanishedVehicles() const { return vanished_vehicles_; }
   /// Exit commitments / withdrawals SUMO refused (the vehicle kept its route).
   std::uint64_t routeChangesFailed() const { return route_changes_failed_; }
+  /// Vehicles SUMO dropped at insertion so far: loaded from a flow, never departed, no
+  /// longer waiting (they waited longer than --max-depart-delay). Asks SUMO.
+  std::uint64_t insertionDropped() const;
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -214,6 +217,7 @@ class SumoSession {
   bool open_ = false;
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
   std::uint64_t route_changes_failed_ = 0;
+  std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
