@@ -59,6 +59,10 @@ record() {  # NAME FAILURE("" = passed)
   names+=("$1"); failures+=("$2")
   if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
 }
+fail_keeping_work() {  # NAME FAILURE: a failed check; the work folder stays for its logs
+  record "$1" "$2"
+  KEEP_WORK=true
+}
 
 # beats POLICY_DSR POLICY_SPEED KEEP_DSR KEEP_SPEED: the policy beats keep as defined above.
 beats() {
@@ -79,8 +83,7 @@ fi
 if beats "$dsr" "$speed" "$keep_dsr" "$keep_speed"; then
   record trained_policy_beats_keep ""
 else
-  record trained_policy_beats_keep "DSR $dsr % at $speed m/s vs keep $keep_dsr % at $keep_speed m/s: needs keep + $MARGIN points at >= $SPEED_SHARE x its speed (logs: $WORK)"
-  KEEP_WORK=true
+  fail_keeping_work trained_policy_beats_keep "DSR $dsr % at $speed m/s vs keep $keep_dsr % at $keep_speed m/s: needs keep + $MARGIN points at >= $SPEED_SHARE x its speed (logs: $WORK)"
 fi
 
 read -r dsr0 speed0 keep_dsr0 keep_speed0 < <(train_and_compare no_learning "$ROOT/config/training/no_learning.yaml" || echo "nan nan nan nan")
@@ -89,11 +92,9 @@ beats "$dsr0" "$speed0" "$keep_dsr0" "$keep_speed0"; verdict=$?
 if [ "$verdict" -eq 1 ]; then
   record untrained_policy_does_not ""
 elif [ "$verdict" -eq 2 ]; then
-  record untrained_policy_does_not "the learning-off run failed (logs: $WORK)"
-  KEEP_WORK=true
+  fail_keeping_work untrained_policy_does_not "the learning-off run failed (logs: $WORK)"
 else
-  record untrained_policy_does_not "learning rate 0 gave DSR $dsr0 % at $speed0 m/s vs keep $keep_dsr0 % at $keep_speed0 m/s: the test does not measure learning"
-  KEEP_WORK=true
+  fail_keeping_work untrained_policy_does_not "learning rate 0 gave DSR $dsr0 % at $speed0 m/s vs keep $keep_dsr0 % at $keep_speed0 m/s: the test does not measure learning"
 fi
 
 # no_jams POLICY_DIR MAIN_EVAL_DIR: the policy against keep on every (seed, demand) of the
@@ -137,15 +138,12 @@ if [ -d "$learnt/train/checkpoints" ] && [ -f "$learnt/eval/palcas/metrics.json"
   if [ "$verdict" -eq 0 ]; then
     record trained_policy_does_not_jam ""
   elif [ "$verdict" -eq 1 ]; then
-    record trained_policy_does_not_jam "the policy jammed the road (speed < $JAM_SHARE x keep's on the same seed and demand; lines above; logs: $WORK)"
-    KEEP_WORK=true
+    fail_keeping_work trained_policy_does_not_jam "the policy jammed the road (speed < $JAM_SHARE x keep's on the same seed and demand; lines above; logs: $WORK)"
   else
-    record trained_policy_does_not_jam "an evaluation of the jam check failed (logs: $WORK)"
-    KEEP_WORK=true
+    fail_keeping_work trained_policy_does_not_jam "an evaluation of the jam check failed (logs: $WORK)"
   fi
 else
-  record trained_policy_does_not_jam "no trained policy to check (the training failed; logs: $WORK)"
-  KEEP_WORK=true
+  fail_keeping_work trained_policy_does_not_jam "no trained policy to check (the training failed; logs: $WORK)"
 fi
 
 failed="$(write_junit palcas_learning "$XML")"
