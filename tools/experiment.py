@@ -1,16 +1,18 @@
 #!/usr/bin/env python3
 """The paper's experiment: arms x PRs x evaluation seeds, each point an independent run.
 
-  experiment.py run     --out DIR [--arms a,b] [--prs 5,10] [--seeds N] [--duration S]
-                        [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
+  experiment.py run     --out DIR [--arms a,b] [--prs 5,10] [--demands 1000,1400] [--seeds N]
+                        [--duration S] [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
   experiment.py plan    (same options): write DIR/plan.txt (one command per point) and
                         DIR/slurm_array.sh, run nothing
   experiment.py point   --out DIR --name POINT   run one planned point (what plan.txt calls)
   experiment.py collect --out DIR   results.csv, tables and figures from the point folders
 
 Layout: DIR/experiment.json (the settings; a later call must agree with them), and per point
-DIR/points/<arm>_pr<P>_s<seed>/ with <arm>/metrics.json, manifest.json, console.log and
-point.json (status, exit code, wall time, command). A point is finished when its
+DIR/points/<arm>_pr<P>_s<seed>/ (with --demands: <arm>_pr<P>_d<D>_s<seed>/) with
+<arm>/metrics.json, manifest.json, console.log and point.json (status, exit code, wall time,
+command). --demands (mainline veh/h per lane) is a dimension beside arms, PRs and seeds;
+without it every point runs at the scenario's own demand, as experiments did before it. A point is finished when its
 metrics.json covers the whole duration; finished points are never run again, so an
 interrupted experiment continues where it stopped. Called by `./palcas experiment`.
 """
@@ -37,6 +39,7 @@ PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..30
 # Settings that define the experiment: a continuation must not change them.
 FIXED_KEYS = ("duration_s", "scenario")
+MAX_DEMAND = 100000.0  # veh/h per lane: what the bridge accepts
 
 
 class UsageError(Exception):
@@ -58,8 +61,9 @@ def parse_list(text, what, convert):
     return out
 
 
-def point_name(arm, pr, seed):
-    return f"{arm}_pr{pr:g}_s{seed}"
+def point_name(arm, pr, seed, demand=None):
+    """<arm>_pr<P>_s<seed>; at a given demand <arm>_pr<P>_d<D>_s<seed>."""
+    return f"{arm}_pr{pr:g}_s{seed}" if demand is None else f"{arm}_pr{pr:g}_d{demand:g}_s{seed}"
 
 
 def training_seeds(policy_dir):
@@ -87,6 +91,12 @@ def settings_from_args(a):
     for pr in prs:
         if not 0.0 <= pr <= 100.0:
             raise UsageError(f"--prs: {pr:g} is outside [0, 100]")
+    demands = None
+    if a.demands is not None:
+        demands = parse_list(a.demands, "demands", float)
+        for d in demands:
+            if not 0.0 < d <= MAX_DEMAND:
+                raise UsageError(f"--demands: {d:g} is outside (0, {MAX_DEMAND:g}] veh/h per lane")
     if a.seeds < 1:
         raise UsageError(f"--seeds: {a.seeds} must be >= 1")
     if not a.duration > 0:
@@ -118,8 +128,11 @@ def settings_from_args(a):
             raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
                              f"seeds of {policy}")
         policies[arm] = policy
-    return {"arms": arms, "prs": prs, "seeds": seeds, "duration_s": float(a.duration),
-            "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
+    settings = {"arms": arms, "prs": prs, "seeds": seeds, "duration_s": float(a.duration),
+                "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
+    if demands is not None:
+        settings["demands"] = demands
+    return settings
 
 
 def merge_settings(out, wanted):
@@ -137,22 +150,30 @@ def merge_settings(out, wanted):
         if have["policies"].get(arm, policy) != policy:
             raise UsageError(f"{out}: arm '{arm}' was run with the policy "
                              f"{have['policies'][arm]}, not {policy}: use another --out")
+    if ("demands" in have) != ("demands" in wanted):
+        said = "--demands " + ",".join(f"{d:g}" for d in have["demands"]) if "demands" in have \
+            else "the scenario's own demand (no --demands)"
+        raise UsageError(f"{out} holds an experiment run at {said}: give the same kind, or use another --out")
     merged = dict(have)
-    for key in ("arms", "prs", "seeds"):
-        merged[key] = have[key] + [v for v in wanted[key] if v not in have[key]]
+    for key in ("arms", "prs", "seeds", "demands"):
+        if key in have:
+            merged[key] = have[key] + [v for v in wanted[key] if v not in have[key]]
     merged["policies"] = {**have["policies"], **wanted["policies"]}
     return merged
 
 
 def points_of(settings):
-    """Every (arm, PR, seed) point; the first seed of each (arm, PR) records trajectories
-    for the figures (the others only metrics, to keep the folder small)."""
+    """Every (arm, PR, demand, seed) point; the first seed of each (arm, PR, demand) records
+    trajectories for the figures (the others only metrics, to keep the folder small). A
+    point's demand is None without --demands (the scenario's own)."""
     pts = []
-    for pr in settings["prs"]:
-        for seed in settings["seeds"]:
-            for arm in settings["arms"]:
-                pts.append({"name": point_name(arm, pr, seed), "arm": arm, "pr": pr, "seed": seed,
-                            "trajectories": seed == settings["seeds"][0]})
+    for demand in settings.get("demands") or [None]:
+        for pr in settings["prs"]:
+            for seed in settings["seeds"]:
+                for arm in settings["arms"]:
+                    pts.append({"name": point_name(arm, pr, seed, demand), "arm": arm, "pr": pr,
+                                "seed": seed, "demand": demand,
+                                "trajectories": seed == settings["seeds"][0]})
     return pts
 
 
@@ -242,6 +263,8 @@ def run_point(out, name):
     cmd = [str(ROOT / "palcas"), "run", "--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}",
            "--seed", str(p["seed"]), "--duration", f"{settings['duration_s']:g}",
            "--scenario", settings["scenario"], "--out", str(d)]
+    if p["demand"] is not None:
+        cmd += ["--demand", f"{p['demand']:g}"]
     if p["arm"] in settings["policies"]:
         cmd += ["--policy", settings["policies"][p["arm"]]]
     if not p["trajectories"]:
@@ -261,7 +284,7 @@ def run_point(out, name):
                 _children.discard(proc)
     wall = time.time() - start
     ok = code == 0 and metrics_complete(out, p, settings["duration_s"])
-    record = {"name": name, "arm": p["arm"], "pr": p["pr"], "seed": p["seed"],
+    record = {"name": name, "arm": p["arm"], "pr": p["pr"], "seed": p["seed"], "demand": p["demand"],
               "status": "done" if ok else "failed", "exit_code": code, "wall_s": round(wall, 1),
               "command": " ".join(shlex.quote(c) for c in cmd), "host": os.uname().nodename}
     if not ok:
@@ -307,8 +330,9 @@ def run_all(out, settings, jobs):
     pts = points_of(settings)
     todo = [p for p in pts if not finished(out, p, settings["duration_s"])]
     done_before = len(pts) - len(todo)
+    demands = f"{len(settings['demands'])} demands x " if settings.get("demands") else ""
     print(f"[experiment] {len(pts)} points ({len(settings['arms'])} arms x "
-          f"{len(settings['prs'])} PRs x {len(settings['seeds'])} seeds, "
+          f"{len(settings['prs'])} PRs x {demands}{len(settings['seeds'])} seeds, "
           f"{settings['duration_s']:g} s each); {done_before} finished before, {len(todo)} to run, "
           f"{jobs} at a time -> {out}", flush=True)
     lock = threading.Lock()
@@ -358,6 +382,8 @@ def common_options(p):
     p.add_argument("--out", required=True)
     p.add_argument("--arms", default="palcas,keep,sumo_native")
     p.add_argument("--prs", default=",".join(str(x) for x in PAPER_PRS))
+    p.add_argument("--demands", default=None,
+                   help="mainline demands [veh/h per lane]; default: the scenario's own")
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--duration", type=float, default=1800.0)
     p.add_argument("--scenario", default="paper")

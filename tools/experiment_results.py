@@ -1,6 +1,11 @@
 """Results of an experiment folder (see experiment.py): results.csv (one row per point),
-the paper-shaped table per metric with mean +/- 95 % interval per (arm, PR) beside the
-paper's published numbers (tables.md and table_<metric>.csv), and the figures."""
+the paper-shaped table per metric with mean +/- 95 % interval per (arm, PR), one table per
+demand, beside the paper's published numbers (tables.md and table_<metric>.csv), and the
+figures (with --demands: capacity.png, speed and throughput against demand).
+
+A mean can hide a jam: every speed and DSR cell also shows its worst seed, and a point whose
+mean speed is below JAM_SHARE x SUMO-native's on the same seed, PR and demand is a jam:
+marked JAM in its cell, listed at the top of tables.md, "yes" in results.csv's jam column."""
 import csv
 import json
 import math
@@ -20,8 +25,15 @@ METRICS = [
     ("dsr_pct", "DSR (%)", 1),
     ("msr_pct", "MSR (%)", 1),
     ("comfort_share_pct", "Comfort share, |a| <= 1.47 (%)", 1),
+    ("throughput_vph", "Throughput, vehicles arrived (veh/h)", 0),
 ]
-EXTRA = ["efficiency_cav_mps", "decision_ms_p99", "lane_changes_dropped", "collisions",
+# Cells that show their worst seed beside the mean (the lowest value is the worst).
+WORST_OF = ("efficiency_all_mps", "dsr_pct")
+SPEED = "efficiency_all_mps"
+JAM_SHARE = 0.5  # a point below this share of SUMO-native's speed on the same traffic jammed
+REFERENCE_ARM = "sumo_native"
+EXTRA = ["efficiency_cav_mps", "insertion_dropped", "mean_travel_time_s", "lane_changes_per_cav",
+         "decision_ms_p99", "lane_changes_dropped", "collisions",
          "teleports", "cavs_seen", "exiting_cavs", "merging_cavs", "sim_seconds",
          "wall_seconds", "real_time_factor"]
 ARM_TITLES = {"palcas": "PALCAS", "palcas_assist": "PALCAS (assist mode)", "centralized": "Baseline-1 (centralized)",
@@ -38,9 +50,22 @@ def read_paper(path=PAPER_RESULTS):
     return out
 
 
-def point_row(out, p, duration_s):
+def scenario_demand(scenario):
+    """mainline_flow_vphpl of config/scenarios/<scenario>/scenario.yaml (None when unknown)."""
+    import yaml
+    f = ROOT / "config" / "scenarios" / scenario / "scenario.yaml"
+    try:
+        return float(yaml.safe_load(f.read_text())["mainline_flow_vphpl"])
+    except (OSError, KeyError, TypeError, ValueError):
+        return None
+
+
+def point_row(out, p, duration_s, own_demand=None):
+    """A row of results.csv; `demand` is the point's, else the scenario's own (own_demand)."""
     d = out / "points" / p["name"]
-    row = {"point": p["name"], "arm": p["arm"], "pr": p["pr"], "seed": p["seed"]}
+    demand = p.get("demand")
+    row = {"point": p["name"], "arm": p["arm"], "pr": p["pr"],
+           "demand": demand if demand is not None else own_demand, "seed": p["seed"]}
     info = {}
     if (d / "point.json").exists():
         info = json.loads((d / "point.json").read_text())
@@ -71,61 +96,129 @@ def number(v):
     return f if math.isfinite(f) else None
 
 
-def aggregate(rows, arms, prs):
-    """{(arm, pr, metric): (n, mean, half)} over the finished points."""
+def same_traffic(r):
+    """What makes two points the same traffic: seed, PR and demand."""
+    return (str(r["seed"]), number(r["pr"]), number(r.get("demand")))
+
+
+def mark_jams(rows):
+    """Sets each row's "jam": "yes" when its speed is below JAM_SHARE x SUMO-native's on
+    the same seed, PR and demand, "no" when not, "" when there is nothing to compare with
+    (no finished SUMO-native point of that traffic, or not finished itself)."""
+    native = {same_traffic(r): number(r[SPEED]) for r in rows
+              if r["arm"] == REFERENCE_ARM and r["status"] == "done"}
+    for r in rows:
+        ref, speed = native.get(same_traffic(r)), number(r[SPEED])
+        if r["status"] != "done" or ref is None or speed is None:
+            r["jam"] = ""
+        else:
+            r["jam"] = "yes" if speed < JAM_SHARE * ref else "no"
+    return rows
+
+
+def values_of(rows, key):
+    return [number(r[key]) for r in rows if r["status"] == "done" and number(r[key]) is not None]
+
+
+def aggregate(rows, arms, prs, demands):
+    """{(arm, pr, demand, metric): cell} over the finished points; a cell is a dict with n,
+    mean, half, worst and worst_seed (lowest value, for WORST_OF) and jams (seeds that jammed)."""
     agg = {}
     for arm in arms:
         for pr in prs:
-            sel = [r for r in rows if r["arm"] == arm and r["pr"] == pr and r["status"] == "done"]
-            for key, _, _ in METRICS:
-                vals = [number(r[key]) for r in sel]
-                vals = [v for v in vals if v is not None]
-                if vals:
-                    mean, half = mean_ci95(vals)
-                    agg[(arm, pr, key)] = (len(vals), mean, half)
+            for demand in demands:
+                sel = [r for r in rows if r["arm"] == arm and number(r["pr"]) == pr
+                       and number(r.get("demand")) == demand and r["status"] == "done"]
+                jams = sorted(str(r["seed"]) for r in sel if r.get("jam") == "yes")
+                for key, _, _ in METRICS:
+                    vals = [(number(r[key]), r["seed"]) for r in sel if number(r[key]) is not None]
+                    if not vals:
+                        continue
+                    mean, half = mean_ci95([v for v, _ in vals])
+                    worst, worst_seed = min(vals, key=lambda x: x[0])
+                    agg[(arm, pr, demand, key)] = {"n": len(vals), "mean": mean, "half": half,
+                                                   "worst": worst, "worst_seed": worst_seed,
+                                                   "jams": jams}
     return agg
+
+
+def demands_of(rows):
+    out = []
+    for r in rows:
+        d = number(r.get("demand"))
+        if d not in out:
+            out.append(d)
+    return sorted(out, key=lambda d: (d is None, d or 0.0))
+
+
+def cell_text(c, key, digits):
+    text = format_ci(c["mean"], c["half"], digits)
+    if key in WORST_OF and c["n"] > 1:
+        text += f" (worst {c['worst']:.{digits}f}, s{c['worst_seed']})"
+    if c["jams"]:
+        text += " **JAM** (s" + ", s".join(c["jams"]) + ")"
+    return text
+
+
+def demand_title(demand):
+    return "demand: the scenario's own" if demand is None else f"demand {demand:g} veh/h/lane"
 
 
 def write_tables(out, settings, rows, agg, paper):
     arms, prs = settings["arms"], settings["prs"]
+    demands = demands_of(rows) or [None]
     md = [f"# Experiment results\n",
           f"Road `{settings['scenario']}`, {settings['duration_s']:g} s per point, evaluation seeds "
-          f"{', '.join(str(s) for s in settings['seeds'])}; each cell: mean ± half-width of the "
-          "two-sided 95 % Student-t interval over the seeds (n in the CSV). *paper*: the "
-          "published value ± its printed spread (on the paper's own road and demand).\n"]
+          f"{', '.join(str(s) for s in settings['seeds'])}, "
+          + ", ".join(demand_title(d) for d in demands) + "; each cell: mean ± half-width of the "
+          "two-sided 95 % Student-t interval over the seeds (n in the CSV); speed and DSR cells "
+          "also give their worst seed. *paper*: the published value ± its printed spread (on the "
+          f"paper's own road and demand). **JAM**: a seed whose speed was below {JAM_SHARE:g} x "
+          "SUMO-native's on the same seed, PR and demand.\n"]
     bad = [r for r in rows if r["status"] != "done"]
     if bad:
         md.append("**Not in the tables** (" + str(len(bad)) + " point(s)): " +
                   ", ".join(f"{r['point']} ({r['status']})" for r in bad) + "\n")
+    jammed = [r for r in rows if r.get("jam") == "yes"]
+    if jammed:
+        md.append(f"**JAM** ({len(jammed)} point(s) below {JAM_SHARE:g} x SUMO-native's speed on the same "
+                  "traffic): " + ", ".join(f"{r['point']} ({number(r[SPEED]):.2f} m/s)" for r in jammed) + "\n")
+    elif not any(r["arm"] == REFERENCE_ARM for r in rows):
+        md.append(f"Jams not checked: no {REFERENCE_ARM} arm to compare with.\n")
     for key, label, digits in METRICS:
         md.append(f"\n## {label}\n")
-        head = ["PR (%)"]
-        for arm in arms:
-            head.append(ARM_TITLES.get(arm, arm))
-            if any((arm, pr, key) in paper for pr in prs):
-                head.append(f"{ARM_TITLES.get(arm, arm)}, paper")
-        md.append("| " + " | ".join(head) + " |")
-        md.append("|" + "---|" * len(head))
+        has_paper = [arm for arm in arms if any((arm, pr, key) in paper for pr in prs)]
         csv_rows = []
-        for pr in prs:
-            cells = [f"{pr:g}"]
+        for demand in demands:
+            if len(demands) > 1 or demand is not None:
+                md.append(f"\n### {demand_title(demand)}\n")
+            head = ["PR (%)"]
             for arm in arms:
-                if (arm, pr, key) in agg:
-                    n, mean, half = agg[(arm, pr, key)]
-                    cells.append(format_ci(mean, half, digits))
-                else:
-                    n, mean, half = 0, float("nan"), float("nan")
-                    cells.append("n/a")
-                pm = paper.get((arm, pr, key))
-                if any((arm, p2, key) in paper for p2 in prs):
-                    cells.append(f"*{pm[0]:.{digits}f} ± {pm[1]:.{digits}f}*" if pm else "")
-                csv_rows.append([arm, f"{pr:g}", n, "" if math.isnan(mean) else round(mean, 4),
-                                 "" if math.isnan(half) else round(half, 4),
-                                 pm[0] if pm else "", pm[1] if pm else ""])
-            md.append("| " + " | ".join(cells) + " |")
+                head.append(ARM_TITLES.get(arm, arm))
+                if arm in has_paper:
+                    head.append(f"{ARM_TITLES.get(arm, arm)}, paper")
+            md.append("| " + " | ".join(head) + " |")
+            md.append("|" + "---|" * len(head))
+            for pr in prs:
+                cells = [f"{pr:g}"]
+                for arm in arms:
+                    c = agg.get((arm, pr, demand, key))
+                    cells.append(cell_text(c, key, digits) if c else "n/a")
+                    pm = paper.get((arm, pr, key))
+                    if arm in has_paper:
+                        cells.append(f"*{pm[0]:.{digits}f} ± {pm[1]:.{digits}f}*" if pm else "")
+                    c = c or {"n": 0, "mean": float("nan"), "half": float("nan"), "worst": None,
+                              "worst_seed": "", "jams": []}
+                    csv_rows.append([arm, f"{pr:g}", "" if demand is None else f"{demand:g}", c["n"],
+                                     "" if math.isnan(c["mean"]) else round(c["mean"], 4),
+                                     "" if math.isnan(c["half"]) else round(c["half"], 4),
+                                     "" if c["worst"] is None else round(c["worst"], 4), c["worst_seed"],
+                                     " ".join(c["jams"]), pm[0] if pm else "", pm[1] if pm else ""])
+                md.append("| " + " | ".join(cells) + " |")
         with open(out / f"table_{key}.csv", "w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(["arm", "pr", "n", "mean", "ci95_half", "paper_mean", "paper_pm"])
+            w.writerow(["arm", "pr", "demand", "n", "mean", "ci95_half", "worst", "worst_seed", "jam_seeds",
+                        "paper_mean", "paper_pm"])
             w.writerows(csv_rows)
     walls = {}
     for r in rows:
@@ -150,43 +243,102 @@ def write_results_csv(out, rows):
         w.writerows(rows)
 
 
-def draw_figures(out, settings):
-    """The figures of the first seed at the highest PR (the paper's 60 %): one run folder
-    per arm, gathered by symlinks so run_figures sees them side by side."""
+def draw_capacity(out, arms, prs, rows):
+    """figures/capacity.png (+ .csv): mean speed and throughput against demand, a line per
+    arm, 95 % intervals over the seeds as error bars; one row of panels per PR."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    demands = [d for d in demands_of(rows) if d is not None]
+    table = []
+    fig, axes = plt.subplots(len(prs), 2, figsize=(11, 3.6 * len(prs)), squeeze=False)
+    for i, pr in enumerate(prs):
+        for j, (key, label) in enumerate(((SPEED, "mean speed, all vehicles (m/s)"),
+                                          ("throughput_vph", "throughput (veh/h arrived)"))):
+            ax = axes[i][j]
+            for arm in arms:
+                xs, ys, hs = [], [], []
+                for demand in demands:
+                    sel = [r for r in rows if r["arm"] == arm and number(r["pr"]) == pr
+                           and number(r.get("demand")) == demand]
+                    vals = values_of(sel, key)
+                    if not vals:
+                        continue
+                    mean, half = mean_ci95(vals)
+                    xs.append(demand)
+                    ys.append(mean)
+                    hs.append(half if math.isfinite(half) else 0.0)
+                    table.append([arm, f"{pr:g}", f"{demand:g}", key, len(vals), round(mean, 4),
+                                  round(half, 4) if math.isfinite(half) else ""])
+                if xs:
+                    ax.errorbar(xs, ys, yerr=hs, marker="o", capsize=3, label=ARM_TITLES.get(arm, arm))
+            ax.set_xlabel("mainline demand (veh/h per lane)")
+            ax.set_ylabel(label)
+            ax.set_title(f"PR {pr:g} %")
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=8)
+    fig.suptitle("Capacity: mean and 95 % interval over seeds")
+    fig.tight_layout()
+    (out / "figures").mkdir(parents=True, exist_ok=True)
+    fig.savefig(out / "figures" / "capacity.png", dpi=110)
+    plt.close(fig)
+    with open(out / "figures" / "capacity.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["arm", "pr", "demand", "metric", "n", "mean", "ci95_half"])
+        w.writerows(table)
+    return str(out / "figures" / "capacity.png")
+
+
+def draw_figures(out, settings, points):
+    """The figures of the first seed at the highest PR (the paper's 60 %) and the first
+    demand: one run folder per arm, gathered by symlinks so run_figures sees them side by
+    side."""
     import run_figures
     pr = max(settings["prs"])
     seed = settings["seeds"][0]
+    demand = (settings.get("demands") or [None])[0]
     gather = out / "figures" / "runs"
     gather.mkdir(parents=True, exist_ok=True)
-    for arm in settings["arms"]:
-        src = out / "points" / f"{arm}_pr{pr:g}_s{seed}" / arm
-        link = gather / arm
+    for p in points:
+        if p["pr"] != pr or p["seed"] != seed or p.get("demand") != demand:
+            continue
+        src = out / "points" / p["name"] / p["arm"]
+        link = gather / p["arm"]
         if link.is_symlink() or link.exists():
             link.unlink()
         if (src / "trajectories.csv").exists():
             link.symlink_to(src)
     policies = {a: p for a, p in settings.get("policies", {}).items()}
     pngs = run_figures.figures_for_run(gather, out / "figures", policies=policies)
+    at = "" if demand is None else f", demand {demand:g} veh/h/lane"
     (out / "figures" / "README.md").write_text(
-        f"Figures of seed {seed} at PR {pr:g} % ({settings['duration_s']:g} s), drawn from the "
+        f"Figures of seed {seed} at PR {pr:g} %{at} ({settings['duration_s']:g} s), drawn from the "
         "recorded trajectories.csv / decisions.csv of each arm's point (runs/ links to them) "
-        "and the learning arms' training records. Each PNG has its CSV beside it.\n")
+        "and the learning arms' training records. Each PNG has its CSV beside it."
+        + (" capacity.png: speed and throughput against demand, every seed." if settings.get("demands") else "")
+        + "\n")
     return pngs
 
 
 def collect(out, settings, points):
     out = pathlib.Path(out)
-    rows = [point_row(out, p, settings["duration_s"]) for p in points]
+    own = scenario_demand(settings["scenario"])
+    rows = mark_jams([point_row(out, p, settings["duration_s"], own) for p in points])
     write_results_csv(out, rows)
-    agg = aggregate(rows, settings["arms"], settings["prs"])
+    agg = aggregate(rows, settings["arms"], settings["prs"], demands_of(rows))
     write_tables(out, settings, rows, agg, read_paper())
     done = sum(r["status"] == "done" for r in rows)
     pngs = []
     if done:
         try:
-            pngs = draw_figures(out, settings)
+            pngs = draw_figures(out, settings, points)
         except Exception as e:  # a figure must not lose the tables
             print(f"[experiment] figures failed: {e}", file=sys.stderr)
+        if settings.get("demands"):
+            try:
+                pngs.append(draw_capacity(out, settings["arms"], settings["prs"], rows))
+            except Exception as e:
+                print(f"[experiment] capacity figure failed: {e}", file=sys.stderr)
     print(f"[experiment] {done}/{len(rows)} points in the tables: {out / 'tables.md'}, "
           f"{out / 'results.csv'}; {len(pngs)} figures in {out / 'figures'}")
     return 0 if done == len(rows) else 1
@@ -206,6 +358,8 @@ def merge(out, csv_paths, seeds, duration_s, scenario):
                     raise ValueError(f"{path}: point {r['point']} is already in another results.csv")
                 seen.add(r["point"])
                 r["pr"] = float(r["pr"])
+                if not r.get("demand"):  # a results.csv from before the demand column
+                    r["demand"] = scenario_demand(scenario)
                 if int(r["seed"]) not in seeds:
                     raise ValueError(f"{path}: point {r['point']} has seed {r['seed']}, not one of {seeds}")
                 rows.append(r)
@@ -215,8 +369,9 @@ def merge(out, csv_paths, seeds, duration_s, scenario):
                     prs.append(r["pr"])
     settings = {"arms": arms, "prs": sorted(prs), "seeds": seeds, "duration_s": duration_s,
                 "scenario": scenario}
+    rows = mark_jams(rows)
     write_results_csv(out, rows)
-    write_tables(out, settings, rows, aggregate(rows, arms, settings["prs"]), read_paper())
+    write_tables(out, settings, rows, aggregate(rows, arms, settings["prs"], demands_of(rows)), read_paper())
     return rows
 
 

@@ -7,9 +7,23 @@ the checked values; options the user did not give are absent. What is left to ch
 (a resumed training's record) is checked before any folder is made or process started.
 
 usage: train.py --root REPO --out DIR [--resume] [--arm A] [--episodes N] [--duration S]
-                [--pr P] [--seed N] [--scenario NAME] [--explore-fraction F]
+                [--pr P | --pr-range MIN,MAX] [--demand VPHPL | --demand-range MIN,MAX]
+                [--ramp-demand VPH] [--seed N] [--scenario NAME] [--explore-fraction F]
                 [--learning FILE] [--rsu-params FILE] [--bridge-params FILE]
                 [--paper-printed] --command-line TEXT [--check-only]
+
+Demand: --demand sets the mainline demand [veh/h per lane] and --ramp-demand the on-ramp
+demand [veh/h per ramp] of every episode (the launch's demand / ramp_demand; absent = the
+scenario's own). --demand-range and --pr-range draw each episode's demand / PR uniformly
+from [MIN, MAX]: episode k's draw comes from its own generator seeded with (seed, k), so it
+is the same whatever ran before it (a resumed or extended training draws the episodes it
+adds as a fresh one would). The bridge writes one generated scenario per launch (demand and
+PR are in its routes file), so with a range every episode is its own roslaunch (episodes:=1,
+first_episode:=k, its demand and PR); the RSUs and the server resume from their checkpoints
+(weights, optimiser, replay, epsilon, RNG: the same path as a crashed episode takes), which
+costs a few seconds of start-up per episode and changes nothing else. Without a range the
+episodes share one launch, as before. The ranges and every episode's draw are in train.json
+(episode_draws), and the bridge writes each episode's demand and PR into episodes.csv.
 
 Exit status: 0 done; 1 a node died for good or nothing was trained; 2 a bad option;
 130 / 143 interrupted (SIGINT / SIGTERM: every process stopped and checkpointed)."""
@@ -17,6 +31,7 @@ import argparse
 import datetime
 import json
 import os
+import random
 import re
 import signal
 import socket
@@ -25,10 +40,17 @@ import sys
 
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
-            "scenario": "paper", "explore_fraction": 0.5}
+            "scenario": "paper", "explore_fraction": 0.5, "demand": None, "ramp_demand": None,
+            "demand_range": None, "pr_range": None}
 # Options a resumed training takes from its record (record key per option).
 RESUMED = {"arm": "arm", "scenario": "scenario", "pr": "pr", "seed": "seed", "duration": "duration_s"}
+# The same for the demand options; a record without them (older trainings) had none (None).
+RESUMED_DEMAND = {"demand": "demand_vphpl", "ramp_demand": "ramp_demand_vph",
+                  "demand_range": "demand_range", "pr_range": "pr_range"}
+ALL_GIVEN = ("arm", "episodes", "duration", "pr", "seed", "scenario", "explore_fraction", "demand",
+             "ramp_demand", "demand_range", "pr_range")
 ANSI = re.compile(r"\x1b\[[0-9;]*m")
+MAX_DEMAND = 100000  # veh/h per lane: what the bridge accepts
 
 
 class OptionError(Exception):
@@ -45,10 +67,58 @@ def number_text(value):
 
 
 def same_value(a, b):
+    if isinstance(a, (list, tuple)) or isinstance(b, (list, tuple)):
+        return (isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)) and len(a) == len(b)
+                and all(same_value(x, y) for x, y in zip(a, b)))
+    if a is None or b is None:
+        return a is None and b is None
     try:
         return float(a) == float(b)
     except (TypeError, ValueError):
         return str(a) == str(b)
+
+
+def value_text(value):
+    """A recorded option as the user would write it: 60, 1000,2000, or (the scenario's)."""
+    if value is None:
+        return "(the scenario's)"
+    if isinstance(value, (list, tuple)):
+        return ",".join(number_text(v) for v in value)
+    return number_text(value)
+
+
+def parse_range(text, option, low, high):
+    """'MIN,MAX' -> [MIN, MAX] within [low, high], MIN <= MAX. Raises OptionError naming the option."""
+    parts = text.split(",")
+    try:
+        lo, hi = (float(p) for p in parts) if len(parts) == 2 else (None, None)
+    except ValueError:
+        lo = hi = None
+    if lo is None or not (low <= lo <= high and low <= hi <= high):
+        raise OptionError("%s '%s': expected MIN,MAX, two numbers in [%s, %s]"
+                          % (option, text, number_text(low), number_text(high)))
+    if lo > hi:
+        raise OptionError("%s '%s': MIN %s is greater than MAX %s" % (option, text, number_text(lo), number_text(hi)))
+    return [as_number(lo), as_number(hi)]
+
+
+def episode_draw(opts, episode):
+    """Demand [veh/h per lane] (None = the scenario's) and PR [%] of episode k: drawn from
+    the ranges with a generator of its own, seeded by the training seed and k."""
+    rng = random.Random("palcas-train:%d:%d" % (int(opts["seed"]), episode))
+    demand, pr = opts.get("demand"), opts["pr"]
+    if opts.get("demand_range"):
+        lo, hi = opts["demand_range"]
+        demand = round(rng.uniform(lo, hi), 1)
+    if opts.get("pr_range"):
+        lo, hi = opts["pr_range"]
+        pr = round(rng.uniform(lo, hi), 2)
+    return {"episode": episode, "seed": int(opts["seed"]) + episode,
+            "demand_vphpl": as_number(demand) if demand is not None else None, "pr": as_number(pr)}
+
+
+def sampled(opts):
+    return bool(opts.get("demand_range") or opts.get("pr_range"))
 
 
 def read_record(out):
@@ -86,6 +156,13 @@ def settle_options(given, out, resume):
             raise OptionError("--resume: '%s' trained with %s %s, not %s %s (leave %s out to continue it)"
                               % (out, flag, number_text(recorded), flag, number_text(given[option]), flag))
         opts[option] = recorded
+    for option, key in RESUMED_DEMAND.items():
+        recorded = record.get(key)
+        if given.get(option) is not None and not same_value(given[option], recorded):
+            flag = "--" + option.replace("_", "-")
+            raise OptionError("--resume: '%s' trained with %s %s, not %s %s (leave %s out to continue it)"
+                              % (out, flag, value_text(recorded), flag, value_text(given[option]), flag))
+        opts[option] = recorded
     if given.get("episodes") is None:
         opts["episodes"] = record["episodes"]
     if given.get("explore_fraction") is not None:
@@ -109,7 +186,12 @@ def write_record(out, opts, git_commit):
               "episodes": opts["episodes"], "duration_s": as_number(opts["duration"]), "learning": opts.get("learning") or "",
               "rsu_params": opts.get("rsu_params") or "", "bridge_params": opts.get("bridge_params") or "",
               "paper_printed": bool(opts.get("paper_printed")), "explore_fraction": opts["explore_fraction"],
+              "demand_vphpl": as_number(opts["demand"]) if opts.get("demand") is not None else None,
+              "ramp_demand_vph": as_number(opts["ramp_demand"]) if opts.get("ramp_demand") is not None else None,
+              "demand_range": opts.get("demand_range"), "pr_range": opts.get("pr_range"),
               "git_commit": git_commit}
+    if sampled(opts):
+        record["episode_draws"] = [episode_draw(opts, k) for k in range(int(opts["episodes"]))]
     tmp = os.path.join(out, ".train.json.tmp")
     with open(tmp, "w") as f:
         json.dump(record, f)
@@ -232,15 +314,19 @@ class Interrupt:
 
 
 def run_launches(root, out, opts, record, args, interrupt):
-    """The launch loop: one roslaunch for the episodes left; a simulation that died ends
-    that episode only (the nodes checkpointed) and the next launch goes on with the next
-    episode. Returns the exit status."""
+    """The launch loop: one roslaunch for the episodes left (one per episode when demand or
+    PR is drawn per episode); a simulation that died ends that episode only (the nodes
+    checkpointed) and the next launch goes on with the next episode. Returns the exit status."""
     episodes, seed = int(opts["episodes"]), int(opts["seed"])
     clusters = scenario_clusters(root, opts["scenario"])
     auth_key = message_key(out)
     done = episodes_done(out)
-    log("training %s: episodes %d..%d x %ss, pr=%s%% seed=%d -> %s"
-        % (opts["arm"], done + 1, episodes, number_text(opts["duration"]), number_text(opts["pr"]), seed, out))
+    log("training %s: episodes %d..%d x %ss, pr=%s%% demand=%s seed=%d -> %s"
+        % (opts["arm"], done + 1, episodes, number_text(opts["duration"]),
+           value_text(opts["pr_range"] or opts["pr"]) + (" (drawn per episode)" if opts["pr_range"] else ""),
+           value_text(opts["demand_range"] or opts["demand"])
+           + (" veh/h/lane" if opts["demand_range"] or opts["demand"] is not None else "")
+           + (" (drawn per episode)" if opts["demand_range"] else ""), seed, out))
     nxt, launches, status = done, 0, 0
     env = dict(os.environ, ROS_HOSTNAME="127.0.0.1", ROS_LOG_DIR=os.path.join(out, "ros_log"))
     while nxt < episodes and launches < episodes + 3 + episodes // 4:
@@ -249,9 +335,15 @@ def run_launches(root, out, opts, record, args, interrupt):
         port = free_port()
         env["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
         resume_nodes = "true" if (nxt > 0 or args.resume) else "false"
+        draw = episode_draw(opts, nxt)
+        count = 1 if sampled(opts) else episodes - nxt
+        if sampled(opts):
+            log("episode %d: demand %s, pr %s%%" % (nxt + 1, value_text(draw["demand_vphpl"]), number_text(draw["pr"])))
         launch_args = [
-            "arm:=%s" % opts["arm"], "mode:=train", "pr:=%s" % number_text(opts["pr"]), "seed:=%d" % seed,
-            "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % (episodes - nxt),
+            "arm:=%s" % opts["arm"], "mode:=train", "pr:=%s" % number_text(draw["pr"]), "seed:=%d" % seed,
+            "demand:=%s" % ("scenario" if draw["demand_vphpl"] is None else number_text(draw["demand_vphpl"])),
+            "ramp_demand:=%s" % ("scenario" if opts.get("ramp_demand") is None else number_text(opts["ramp_demand"])),
+            "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % count,
             "first_episode:=%d" % nxt, "duration:=%s" % number_text(opts["duration"]),
             "checkpoint_dir:=%s" % os.path.join(out, "checkpoints"), "resume:=%s" % resume_nodes,
             "out_dir:=%s" % out, "learning_params:=%s" % (opts.get("learning") or "none"),
@@ -268,7 +360,7 @@ def run_launches(root, out, opts, record, args, interrupt):
             monitor = subprocess.Popen(
                 ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(root, "tools", "train_monitor.py"),
                  "--rsus"] + rsu_ids(opts["arm"], clusters)
-                + ["--episodes", str(episodes - nxt), "--first-episode", str(nxt),
+                + ["--episodes", str(count), "--first-episode", str(nxt),
                    "--duration", number_text(opts["duration"]), "--period", "15"],
                 stderr=subprocess.DEVNULL, env=env)
             while True:
@@ -296,10 +388,11 @@ def run_launches(root, out, opts, record, args, interrupt):
                         % (launches, ", ".join(lost), rows_before + 1, rows_after))
             return 1
         nxt += rows_after - rows_before
-        if nxt < episodes and status in (130, 143):  # roslaunch itself was interrupted
+        short = rows_after - rows_before < count  # this launch did not finish its episodes
+        if short and status in (130, 143):  # roslaunch itself was interrupted
             log("interrupted")
             break
-        if nxt < episodes:
+        if short:
             # The simulation died (SUMO assertion, signal, or a fatal error of the bridge):
             # that episode only is lost; the training goes on with the next one (its own seed).
             why = crash_reason(console_text)
@@ -322,6 +415,10 @@ def parse(argv):
     ap.add_argument("--episodes", type=int)
     ap.add_argument("--duration", type=float)
     ap.add_argument("--pr", type=float)
+    ap.add_argument("--pr-range", help="MIN,MAX [%%]: each episode draws its PR from it")
+    ap.add_argument("--demand", type=float, help="mainline demand [veh/h per lane]")
+    ap.add_argument("--ramp-demand", type=float, help="on-ramp demand [veh/h per ramp]")
+    ap.add_argument("--demand-range", help="MIN,MAX [veh/h per lane]: each episode draws its demand from it")
     ap.add_argument("--seed", type=int)
     ap.add_argument("--scenario")
     ap.add_argument("--explore-fraction", type=float)
@@ -336,8 +433,15 @@ def parse(argv):
 
 def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
-    given = {k: getattr(args, k) for k in ("arm", "episodes", "duration", "pr", "seed", "scenario", "explore_fraction")}
+    given = {k: getattr(args, k) for k in ALL_GIVEN}
     try:
+        for option, low, high in (("demand_range", 0, MAX_DEMAND), ("pr_range", 0, 100)):
+            if given[option] is not None:
+                given[option] = parse_range(given[option], "--" + option.replace("_", "-"), low, high)
+        if given["demand"] is not None and given["demand_range"] is not None:
+            raise OptionError("--demand and --demand-range: give one of them")
+        if given["pr"] is not None and given["pr_range"] is not None:
+            raise OptionError("--pr and --pr-range: give one of them")
         opts, record = settle_options(given, args.out, args.resume)
     except OptionError as e:
         print("[palcas] error: %s" % e, file=sys.stderr)

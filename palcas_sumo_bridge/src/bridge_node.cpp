@@ -302,6 +302,7 @@ void BridgeNode::publishMetrics() {
   palcas_msgs::EpisodeMetrics msg = toMsg(measure_->metrics().snapshot(), wallSeconds());
   msg.header.stamp = ros::Time(session_->timeS());
   msg.step = session_->stepCount();
+  msg.insertion_dropped = static_cast<std::uint32_t>(session_->insertionDropped());
   metrics_pub_.publish(msg);
   // Time left over every remaining episode, at this episode's pace.
   const int episodes_left = options_.first_episode + options_.episodes - episode_;
@@ -380,6 +381,7 @@ void BridgeNode::runEpisode(int episode) {
   summary.vanished_vehicles = session_->vanishedVehicles();
   summary.route_changes_failed = session_->routeChangesFailed();
   summary.guard = session_->guardCounters();
+  summary.insertion_dropped = session_->insertionDropped();
   writeMetricsJson(options_, summary, episode);
   ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
            options_.first_episode + options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());

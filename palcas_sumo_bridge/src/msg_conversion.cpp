@@ -85,6 +85,9 @@ palcas_msgs::EpisodeMetrics toMsg(const metrics::EpisodeMetrics& m, double wall_
   out.dsr_pct = m.dsr_pct;
   out.msr_pct = m.msr_pct;
   out.comfort_share_pct = m.comfort_share_pct;
+  out.throughput_vph = m.throughput_vph;
+  out.mean_travel_time_s = m.mean_travel_time_s;
+  out.lane_changes_per_cav = m.lane_changes_per_cav;
   out.collisions = m.collisions;
   out.cav_collisions = m.cav_collisions;
   out.teleports = m.teleports;
@@ -94,6 +97,8 @@ palcas_msgs::EpisodeMetrics toMsg(const metrics::EpisodeMetrics& m, double wall_
   out.exits_missed = m.exits_missed;
   out.merging_cavs = m.merging_cavs;
   out.merges_ok = m.merges_ok;
+  out.arrived = m.arrived;
+  out.cav_lane_changes = m.cav_lane_changes;
   out.vehicles_on_road = m.vehicles_on_road;
   out.advisories_applied = m.advisories_applied;
   out.advisories_rejected = m.advisories_rejected;

@@ -50,6 +50,25 @@ void writeAtomically(const std::string& path, const json& content) {
   fs::rename(tmp, path);
 }
 
+/// A resumed training's episodes.csv written before columns were added at its end: the
+/// header becomes the current one, the old rows stay (their new columns read as empty).
+void upgradeHeader(const std::string& csv, const std::string& header) {
+  std::ifstream in(csv);
+  std::string first;
+  std::getline(in, first);
+  if (first == header || header.compare(0, first.size(), first) != 0 || first.empty()) return;
+  std::stringstream rest;
+  rest << in.rdbuf();
+  in.close();
+  const std::string tmp = csv + ".tmp";
+  {
+    std::ofstream out(tmp);
+    out << header << '\n' << rest.str();
+    if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
+  }
+  fs::rename(tmp, csv);
+}
+
 json twoPoint(const sim::TwoPointSpeed& s) {
   return {{"fast_mps", s.fast_mps}, {"slow_mps", s.slow_mps}, {"p_fast", s.p_fast}};
 }
@@ -140,6 +159,8 @@ std::string prepareScenario(const BridgeOptions& o) {
                    {"config_hash", fingerprint(snapshot.dump())},
                    {"seeds", {{"sumo", config.seed}}},
                    {"pr_percent", 100.0 * config.penetration_rate},
+                   {"demand", {{"mainline_flow_vphpl", config.mainline_flow_vphpl},
+                               {"onramp_flow_vphpl", config.onramp_flow_vphpl}}},
                    {"duration_s", config.duration_s},
                    {"git_commit", o.git_commit},
                    {"command_line", o.command_line},
@@ -234,6 +255,12 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"dsr_pct", number(m.dsr_pct)},
               {"msr_pct", number(m.msr_pct)},
               {"comfort_share_pct", number(m.comfort_share_pct)},
+              {"throughput_vph", number(m.throughput_vph)},
+              {"insertion_dropped", s.insertion_dropped},
+              {"mean_travel_time_s", number(m.mean_travel_time_s)},
+              {"lane_changes_per_cav", number(m.lane_changes_per_cav)},
+              {"arrived", m.arrived},
+              {"cav_lane_changes", m.cav_lane_changes},
               {"collisions", m.collisions},
               {"cav_collisions", m.cav_collisions},
               {"teleports", m.teleports},
@@ -262,6 +289,8 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"real_time_factor", number(s.wall_seconds > 0 ? m.sim_seconds / s.wall_seconds : NAN)},
               {"steps", s.steps},
               {"pr_percent", 100.0 * o.scenario.penetration_rate},
+              {"mainline_flow_vphpl", o.scenario.mainline_flow_vphpl},
+              {"onramp_flow_vphpl", o.scenario.onramp_flow_vphpl},
               {"seed", o.scenario.seed + static_cast<unsigned>(episode)},
               {"episode", episode},
               {"episodes", o.episodes},
@@ -278,17 +307,25 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
   // far it got.
   if (m.sim_seconds + 1e-6 < o.scenario.duration_s) return;
   const std::string csv = o.out_dir + "/episodes.csv";
+  const std::string header =
+      "episode,seed,sim_seconds,wall_seconds,efficiency_all_mps,efficiency_cav_mps,"
+      "collision_rate_pct,dsr_pct,msr_pct,comfort_share_pct,cavs_seen,exiting_cavs,"
+      "merging_cavs,advisories,advisories_rejected,late_rsu_steps,mainline_flow_vphpl,"
+      "onramp_flow_vphpl,pr_percent,throughput_vph,insertion_dropped,mean_travel_time_s,"
+      "lane_changes_per_cav";
   const bool fresh = !fs::exists(csv);
+  if (!fresh) upgradeHeader(csv, header);
   std::ofstream rows(csv, std::ios::app);
-  if (fresh)
-    rows << "episode,seed,sim_seconds,wall_seconds,efficiency_all_mps,efficiency_cav_mps,"
-            "collision_rate_pct,dsr_pct,msr_pct,comfort_share_pct,cavs_seen,exiting_cavs,"
-            "merging_cavs,advisories,advisories_rejected,late_rsu_steps\n";
+  if (fresh) rows << header << '\n';
   rows << episode << ',' << o.scenario.seed + static_cast<unsigned>(episode) << ',' << m.sim_seconds
        << ',' << s.wall_seconds << ',' << m.efficiency_all_mps << ',' << m.efficiency_cav_mps << ','
        << m.collision_rate_pct << ',' << m.dsr_pct << ',' << m.msr_pct << ',' << m.comfort_share_pct
        << ',' << m.cavs_seen << ',' << m.exiting_cavs << ',' << m.merging_cavs << ','
-       << m.advisories_applied << ',' << m.advisories_rejected << ',' << m.late_rsu_steps << '\n';
+       << m.advisories_applied << ',' << m.advisories_rejected << ',' << m.late_rsu_steps << ','
+       << o.scenario.mainline_flow_vphpl << ',' << o.scenario.onramp_flow_vphpl << ','
+       << 100.0 * o.scenario.penetration_rate << ',' << m.throughput_vph << ','
+       << s.insertion_dropped << ',' << m.mean_travel_time_s << ',' << m.lane_changes_per_cav
+       << '\n';
 }
 
 RoadView prepareRvizView(const BridgeOptions& options,

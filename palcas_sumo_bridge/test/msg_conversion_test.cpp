@@ -111,10 +111,20 @@ TEST(MsgConversion, MetricsCarryRealTimeFactor) {
   m.sim_seconds = 600.0;
   m.dsr_pct = 87.5;
   m.exits_missed = 3;
+  m.throughput_vph = 2400.0;
+  m.mean_travel_time_s = 41.5;
+  m.lane_changes_per_cav = 0.75;
+  m.arrived = 400;
+  m.cav_lane_changes = 9;
   const auto msg = toMsg(m, 50.0);
   EXPECT_DOUBLE_EQ(msg.real_time_factor, 12.0);  // 600 / 50
   EXPECT_DOUBLE_EQ(msg.dsr_pct, 87.5);
   EXPECT_EQ(msg.exits_missed, 3u);
+  EXPECT_DOUBLE_EQ(msg.throughput_vph, 2400.0);
+  EXPECT_DOUBLE_EQ(msg.mean_travel_time_s, 41.5);
+  EXPECT_DOUBLE_EQ(msg.lane_changes_per_cav, 0.75);
+  EXPECT_EQ(msg.arrived, 400u);
+  EXPECT_EQ(msg.cav_lane_changes, 9u);
   EXPECT_DOUBLE_EQ(toMsg(m, 0.0).real_time_factor, 0.0);
 }
 

@@ -120,6 +120,10 @@ void EpisodeMetricsAccumulator::removeVehicle(
     if (v.is_cav) ++counts_.cav_collisions;
   } else if (kind == VehicleEventKind::kTeleport) {
     ++counts_.teleports;
+  } else if (kind == VehicleEventKind::kArrived) {
+    // Throughput and travel time count normal arrivals only (by any route's end).
+    ++counts_.arrived;
+    travel_time_sum_s_ += sim_seconds_ - v.departed_s;
   }
   // Removed with an outcome still open: a failure (the tracker normally sent it already).
   // Arrived without an exit decided counts as missed; collision / teleport as neither.
@@ -135,7 +139,11 @@ void EpisodeMetricsAccumulator::apply(const VehicleEvent& event) {
       ++ignored_events_;  // second DEPARTED: the first sighting stands
       return;
     }
-    on_road_.emplace(event.vehicle_id, Vehicle{event.is_cav, event.route_kind});
+    Vehicle v;
+    v.is_cav = event.is_cav;
+    v.route_kind = event.route_kind;
+    v.departed_s = sim_seconds_;
+    on_road_.emplace(event.vehicle_id, v);
     if (event.is_cav) ++counts_.cavs_seen;
     return;
   }
@@ -163,6 +171,21 @@ void EpisodeMetricsAccumulator::apply(const VehicleEvent& event) {
     case VehicleEventKind::kDeparted: break;  // handled above
   }
   if (!used) ++ignored_events_;
+}
+
+void EpisodeMetricsAccumulator::addLaneSamples(const std::vector<LaneSample>& lanes) {
+  for (const auto& s : lanes)
+    if (s.lane < 0)
+      throw std::invalid_argument("EpisodeMetricsAccumulator: vehicle '" + s.vehicle_id +
+                                  "' has lane " + std::to_string(s.lane) + ", must be >= 0");
+  for (const auto& s : lanes) {
+    if (s.lane == 0) continue;  // off the mainline lanes: merging and exiting are not changes
+    const auto it = on_road_.find(s.vehicle_id);
+    if (it == on_road_.end()) continue;
+    Vehicle& v = it->second;
+    if (v.mainline_lane != 0 && s.lane != v.mainline_lane && v.is_cav) ++counts_.cav_lane_changes;
+    v.mainline_lane = s.lane;
+  }
 }
 
 void EpisodeMetricsAccumulator::addAdvisoriesApplied(std::uint64_t count) {
@@ -195,6 +218,11 @@ EpisodeMetrics EpisodeMetricsAccumulator::snapshot() const {
   m.dsr_pct = percent(counts_.exits_ok, counts_.exiting_cavs);
   m.msr_pct = percent(counts_.merges_ok, counts_.merging_cavs);
   m.comfort_share_pct = percent(comfortable_cav_, samples_cav_);
+  m.throughput_vph = sim_seconds_ > 0.0 ? 3600.0 * counts_.arrived / sim_seconds_ : NOT_A_NUMBER;
+  m.mean_travel_time_s = mean(travel_time_sum_s_, counts_.arrived);
+  m.lane_changes_per_cav = counts_.cavs_seen == 0
+                               ? NOT_A_NUMBER
+                               : static_cast<double>(counts_.cav_lane_changes) / counts_.cavs_seen;
   m.vehicles_on_road = static_cast<std::uint32_t>(on_road_.size());
   m.advisories_rejected = std::accumulate(rejections_.begin(), rejections_.end(), std::uint64_t{0});
   return m;

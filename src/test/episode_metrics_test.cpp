@@ -37,6 +37,9 @@ TEST(EpisodeMetrics, EmptyDenominatorsAreNaN) {
   EXPECT_TRUE(std::isnan(m.dsr_pct));
   EXPECT_TRUE(std::isnan(m.msr_pct));
   EXPECT_TRUE(std::isnan(m.comfort_share_pct));
+  EXPECT_TRUE(std::isnan(m.throughput_vph));        // no simulated time
+  EXPECT_TRUE(std::isnan(m.mean_travel_time_s));    // nobody arrived
+  EXPECT_TRUE(std::isnan(m.lane_changes_per_cav));  // no CAV seen
   EXPECT_EQ(m.cavs_seen, 0u);
   EXPECT_EQ(m.vehicles_on_road, 0u);
 }
@@ -291,4 +294,63 @@ TEST(EpisodeMetrics, ResetStartsAFreshEpisode) {
   acc.addSample(true, 10.0, 1.9);
   m = acc.snapshot();
   EXPECT_DOUBLE_EQ(m.comfort_share_pct, 100.0);  // threshold 2.0 kept: 1.9 <= 2
+}
+
+TEST(EpisodeMetrics, ThroughputAndTravelTimeCountNormalArrivalsOnly) {
+  EpisodeMetricsAccumulator acc;
+  acc.setSimSeconds(10.0);
+  depart(acc, {"a", "b"}, false, RouteKind::kMainThrough);
+  depart(acc, {"x"}, true, RouteKind::kMainExit);
+  acc.setSimSeconds(40.0);
+  depart(acc, {"c", "crash"}, true, RouteKind::kMainThrough);
+  acc.setSimSeconds(70.0);
+  acc.addEvent(ev("a", false, VehicleEventKind::kArrived));  // 70 - 10 = 60 s
+  acc.addEvent(ev("x", true, VehicleEventKind::kArrived, RouteKind::kMainExit));  // 60 s, off-ramp end
+  acc.setSimSeconds(100.0);
+  acc.addEvent(ev("c", true, VehicleEventKind::kArrived));           // 100 - 40 = 60 s ...
+  acc.addEvent(ev("crash", true, VehicleEventKind::kCollision));     // not an arrival
+  acc.addEvent(ev("b", false, VehicleEventKind::kTeleport));         // not an arrival
+  acc.setSimSeconds(120.0);
+  auto m = acc.snapshot();
+  EXPECT_EQ(m.arrived, 3u);                          // a, x, c
+  EXPECT_DOUBLE_EQ(m.throughput_vph, 90.0);          // 3600 * 3 / 120
+  EXPECT_DOUBLE_EQ(m.mean_travel_time_s, 60.0);      // (60 + 60 + 60) / 3
+  depart(acc, {"d"}, false, RouteKind::kMainThrough);  // at 120
+  acc.setSimSeconds(240.0);
+  acc.addEvent(ev("d", false, VehicleEventKind::kArrived));  // 240 - 120 = 120 s
+  m = acc.snapshot();
+  EXPECT_DOUBLE_EQ(m.throughput_vph, 60.0);          // 3600 * 4 / 240
+  EXPECT_DOUBLE_EQ(m.mean_travel_time_s, 75.0);      // (60 * 3 + 120) / 4
+}
+
+TEST(EpisodeMetrics, LaneChangesPerCavCountMainlineLaneChangesOfCavs) {
+  EpisodeMetricsAccumulator acc;
+  depart(acc, {"c1", "c2", "c3", "c4"}, true, RouteKind::kMainThrough);
+  depart(acc, {"ramp"}, true, RouteKind::kRampExit);
+  depart(acc, {"h"}, false, RouteKind::kMainThrough);
+  // c1: 2 -> 3 -> 3 -> 2: two changes. c2: stays in 1. c3: 1 -> 2 -> 3 in one go of two
+  // steps: two changes. c4 never seen on a lane. ramp: 0 (acceleration lane) -> 1 (a merge,
+  // not a change) -> 0 (off-ramp, not a change). h: 1 -> 2, a human driver: not counted.
+  const std::vector<std::vector<LaneSample>> steps = {
+      {{"c1", 2}, {"c2", 1}, {"c3", 1}, {"ramp", 0}, {"h", 1}},
+      {{"c1", 3}, {"c2", 1}, {"c3", 2}, {"ramp", 1}, {"h", 2}},
+      {{"c1", 3}, {"c2", 1}, {"c3", 3}, {"ramp", 0}},
+      {{"c1", 2}, {"c2", 1}, {"ghost", 4}}};  // an unknown vehicle is skipped
+  for (const auto& step : steps) acc.addLaneSamples(step);
+  auto m = acc.snapshot();
+  EXPECT_EQ(m.cav_lane_changes, 4u);                 // c1 2 + c3 2
+  EXPECT_DOUBLE_EQ(m.lane_changes_per_cav, 0.8);     // 4 / 5 CAVs seen
+  // Off the mainline and back to another lane: the change still counts (last lane 2 -> 1).
+  acc.addLaneSamples({{"c1", 0}});
+  acc.addLaneSamples({{"c1", 1}});
+  m = acc.snapshot();
+  EXPECT_EQ(m.cav_lane_changes, 5u);
+  EXPECT_DOUBLE_EQ(m.lane_changes_per_cav, 1.0);     // 5 / 5
+  // A removed vehicle starts afresh if its id comes back: no change against its old lane.
+  acc.addEvent(ev("c2", true, VehicleEventKind::kArrived));
+  depart(acc, {"c2"}, true, RouteKind::kMainThrough);
+  acc.addLaneSamples({{"c2", 3}});
+  EXPECT_EQ(acc.snapshot().cav_lane_changes, 5u);
+  EXPECT_THROW(acc.addLaneSamples({{"c1", 2}, {"c3", -1}}), std::invalid_argument);
+  EXPECT_EQ(acc.snapshot().cav_lane_changes, 5u);    // c1's good sample was not added
 }

@@ -63,6 +63,18 @@ check run_pr_without_value     "option --pr needs a value"  run --out "$OUT" --p
 check run_real_time_factor_zero "--real-time-factor '0'"   run --out "$OUT" --rviz --real-time-factor 0
 check run_real_time_factor_text "--real-time-factor 'fast'" run --out "$OUT" --real-time-factor fast
 check run_real_time_factor_without_value "option --real-time-factor needs a value" run --out "$OUT" --real-time-factor
+check run_demand_negative      "--demand '-5'"              run --out "$OUT" --demand -5
+check run_demand_not_a_number  "--demand 'lots'"            run --out "$OUT" --demand lots
+check run_demand_too_high      "--demand '200000': expected a number in [0, 100000]" run --out "$OUT" --demand 200000
+check run_demand_without_value "option --demand needs a value" run --out "$OUT" --demand
+check run_ramp_demand_not_a_number "--ramp-demand '5x'"     run --out "$OUT" --ramp-demand 5x
+check train_demand_negative    "--demand '-1'"              train --out "$OUT" --demand -1
+check train_ramp_demand_too_high "--ramp-demand '1e9'"      train --out "$OUT" --ramp-demand 1e9
+check train_demand_range_reversed "--demand-range '2000,1000': MIN 2000 is greater than MAX 1000" train --out "$OUT" --demand-range 2000,1000
+check train_demand_range_one_number "--demand-range '1000': expected MIN,MAX" train --out "$OUT" --demand-range 1000
+check train_pr_range_out_of_range "--pr-range '10,200': MAX '200'" train --out "$OUT" --pr-range 10,200
+check train_demand_and_range   "--demand and --demand-range" train --out "$OUT" --demand 1000 --demand-range 1000,2000
+check train_pr_and_range       "--pr and --pr-range"        train --out "$OUT" --pr 40 --pr-range 10,60
 check train_arm_keep           "--arm keep"                 train --out "$OUT" --arm keep
 check train_episodes_zero      "--episodes '0'"             train --out "$OUT" --episodes 0
 check train_seed_without_value "option --seed needs a value" train --out "$OUT" --seed
@@ -81,6 +93,8 @@ check experiment_pr_out_of_range "--prs: 150 is outside"    experiment --out "$O
 check experiment_seeds_zero    "--seeds: 0 must be >= 1"     experiment --out "$OUT" --arms keep --seeds 0
 check experiment_policy_wrong_road "trained on road paper"  experiment --out "$OUT" --arms palcas --scenario tiny
 check experiment_without_out   "--out"                       experiment --arms keep
+check experiment_demand_zero   "--demands: 0 is outside"     experiment --out "$OUT" --arms keep --demands 1000,0
+check experiment_demand_text   "--demands: 'many' is not valid" experiment --out "$OUT" --arms keep --demands many
 
 # --resume takes road, PR, seed and duration from the training record and refuses a flag
 # that contradicts it (a fake record: these checks stop before anything is built or run).
@@ -102,3 +116,4 @@ check_resume resume_other_pr       "trained with --pr 40, not --pr 60"          
 check_resume resume_other_duration "trained with --duration 300, not --duration 3600" --duration 3600
 check_resume resume_other_scenario "trained with --scenario tiny, not --scenario paper" --scenario paper
 check_resume resume_other_explore  "leave --explore-fraction out"                --explore-fraction 0.3
+check_resume resume_other_demand   "trained with --demand (the scenario's), not --demand 1400" --demand 1400

@@ -98,6 +98,29 @@ else
 fi
 result resume_refuses_a_corrupt_checkpoint "$why"
 
+# --demand / --ramp-demand reach the bridge: the default run folder is named by them, and
+# manifest.json, metrics.json and the generated routes file that SUMO ran show them.
+status=0
+PALCAS_NO_BUILD=1 PALCAS_RESULTS_DIR="$WORK/results" timeout -k 10 300 "$ROOT/palcas" run --arm keep --no-compare \
+  --scenario tiny --duration 20 --pr 40 --seed 7 --demand 1850 --ramp-demand 420 >"$WORK/demand.log" 2>&1 || status=$?
+run_dir="$(ls -d "$WORK"/results/run-*-pr40-d1850-r420-s7 2>/dev/null | head -1)"
+why=""
+if [ "$status" -ne 0 ]; then why="the run failed (exit $status): $(tail -3 "$WORK/demand.log")"
+elif [ -z "$run_dir" ]; then why="no run folder named by the demand: $(ls "$WORK/results")"
+else
+  got="$(/usr/bin/python3 -c 'import json,sys
+m = json.load(open(sys.argv[1] + "/keep/manifest.json"))
+r = json.load(open(sys.argv[1] + "/keep/metrics.json"))
+c = m["config"]["scenario"]
+print(m["demand"]["mainline_flow_vphpl"], m["demand"]["onramp_flow_vphpl"], c["mainline_flow_vphpl"],
+      r["mainline_flow_vphpl"], r["onramp_flow_vphpl"], r["throughput_vph"] is not None, "insertion_dropped" in r)' "$run_dir" 2>&1)"
+  [ "$got" = "1850.0 420.0 1850.0 1850.0 420.0 True True" ] || why="manifest/metrics show '$got', expected '1850.0 420.0 1850.0 1850.0 420.0 True True'"
+  [ -n "$why" ] || grep -q "mainline 1850 veh/h/lane, on-ramp 420 veh/h/lane" "$run_dir"/keep/scenario/*.rou.xml ||
+    why="the routes file SUMO ran does not say 1850 / 420: $(grep -h -o 'mainline [^.]*' "$run_dir"/keep/scenario/*.rou.xml)"
+  [ -n "$why" ] || grep -q "demand=1850 veh/h/lane (ramps 420 veh/h)" "$WORK/demand.log" || why="the run does not say its demand"
+fi
+result run_demand_reaches_the_bridge "$why"
+
 # SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
 # process it started and says so; a training's nodes checkpoint on the way out.
 left_of() {  # DIR: processes whose command line names DIR

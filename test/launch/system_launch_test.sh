@@ -66,6 +66,17 @@ grep -q '^/palcas_sumo_bridge/lane_change_duration_s: 2.5$' <<<"$params" || why=
 names+=(bridge_parameter_layers); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   bridge_parameter_layers"; else echo "FAIL bridge_parameter_layers: $why"; fi
 
+# demand / ramp_demand go over the scenario's flows on the bridge; left out, the scenario's own.
+why=""
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep scenario:=tiny demand:=1850 ramp_demand:=420 out_dir:=/tmp/unused 2>&1)"
+grep -q '^/palcas_sumo_bridge/scenario/mainline_flow_vphpl: 1850.0$' <<<"$params" || why="$why demand:=1850 did not reach the bridge;"
+grep -q '^/palcas_sumo_bridge/scenario/onramp_flow_vphpl: 420.0$' <<<"$params" || why="$why ramp_demand:=420 did not reach the bridge;"
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep scenario:=tiny out_dir:=/tmp/unused 2>&1)"
+grep -q '^/palcas_sumo_bridge/scenario/mainline_flow_vphpl: 1000.0$' <<<"$params" || why="$why without demand the bridge lacks tiny's 1000;"
+grep -q '^/palcas_sumo_bridge/scenario/onramp_flow_vphpl: 300.0$' <<<"$params" || why="$why without ramp_demand the bridge lacks tiny's 300;"
+names+=(demand_reaches_the_bridge); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   demand_reaches_the_bridge"; else echo "FAIL demand_reaches_the_bridge: $why"; fi
+
 why=""
 out="$(roslaunch --nodes palcas_launch system.launch arm:=bogus out_dir:=/tmp/unused 2>&1)" && why="an unknown arm was accepted"
 [ -n "$why" ] || [[ "$out" == *unknown_arm_bogus* ]] || why="the error does not name the arm: $out"

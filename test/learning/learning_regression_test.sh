@@ -4,8 +4,11 @@
 # evaluation seed it never trained on: DSR at least MARGIN points above keep's while the
 # traffic keeps at least SPEED_SHARE of keep's average speed (a policy that gets CAVs out
 # by jamming the road does not count). The same training with learning switched off
-# (learning rate 0: config/training/no_learning.yaml) must not. Asserts on simulated
-# outcomes only, never on wall-clock time.
+# (learning rate 0: config/training/no_learning.yaml) must not. And the learnt policy must
+# not jam the road on traffic it never trained on: on two held-out seeds x two demands
+# (the tiny road's own 1000 veh/h/lane and JAM_DEMAND) its speed stays at least JAM_SHARE
+# of keep's on the same traffic (about 2 more minutes). Asserts on simulated outcomes only,
+# never on wall-clock time.
 #
 #   test/learning/learning_regression_test.sh [--xml FILE] [--keep-work]
 set -uo pipefail
@@ -25,6 +28,10 @@ MARGIN=15          # DSR points above keep a learnt policy must reach
 SPEED_SHARE=0.9    # of keep's average speed (all vehicles) it must keep
 TRAIN_SEED=1       # episodes use seeds 1..16 (a second attempt: 17..32)
 EVAL_SEED=101      # never used in training
+JAM_SEEDS="101 102"     # held-out seeds of the jam check (training: 1..32)
+JAM_DEMANDS="1000 1600" # veh/h/lane: the tiny road's own (config/scenarios/tiny) and a busier one
+JAM_SHARE=0.5           # of keep's speed on the same traffic: below it, the policy jammed the road
+JAM_DURATION=300        # simulated seconds per extra evaluation
 WORK="$(mktemp -d)"
 export PALCAS_NO_BUILD=1  # ./palcas test built the workspace already
 names=() failures=()
@@ -52,6 +59,10 @@ record() {  # NAME FAILURE("" = passed)
   names+=("$1"); failures+=("$2")
   if [ -z "$2" ]; then echo "ok   $1"; else echo "FAIL $1: $2"; fi
 }
+fail_keeping_work() {  # NAME FAILURE: a failed check; the work folder stays for its logs
+  record "$1" "$2"
+  KEEP_WORK=true
+}
 
 # beats POLICY_DSR POLICY_SPEED KEEP_DSR KEEP_SPEED: the policy beats keep as defined above.
 beats() {
@@ -72,8 +83,7 @@ fi
 if beats "$dsr" "$speed" "$keep_dsr" "$keep_speed"; then
   record trained_policy_beats_keep ""
 else
-  record trained_policy_beats_keep "DSR $dsr % at $speed m/s vs keep $keep_dsr % at $keep_speed m/s: needs keep + $MARGIN points at >= $SPEED_SHARE x its speed (logs: $WORK)"
-  KEEP_WORK=true
+  fail_keeping_work trained_policy_beats_keep "DSR $dsr % at $speed m/s vs keep $keep_dsr % at $keep_speed m/s: needs keep + $MARGIN points at >= $SPEED_SHARE x its speed (logs: $WORK)"
 fi
 
 read -r dsr0 speed0 keep_dsr0 keep_speed0 < <(train_and_compare no_learning "$ROOT/config/training/no_learning.yaml" || echo "nan nan nan nan")
@@ -82,11 +92,58 @@ beats "$dsr0" "$speed0" "$keep_dsr0" "$keep_speed0"; verdict=$?
 if [ "$verdict" -eq 1 ]; then
   record untrained_policy_does_not ""
 elif [ "$verdict" -eq 2 ]; then
-  record untrained_policy_does_not "the learning-off run failed (logs: $WORK)"
-  KEEP_WORK=true
+  fail_keeping_work untrained_policy_does_not "the learning-off run failed (logs: $WORK)"
 else
-  record untrained_policy_does_not "learning rate 0 gave DSR $dsr0 % at $speed0 m/s vs keep $keep_dsr0 % at $keep_speed0 m/s: the test does not measure learning"
-  KEEP_WORK=true
+  fail_keeping_work untrained_policy_does_not "learning rate 0 gave DSR $dsr0 % at $speed0 m/s vs keep $keep_dsr0 % at $keep_speed0 m/s: the test does not measure learning"
+fi
+
+# no_jams POLICY_DIR MAIN_EVAL_DIR: the policy against keep on every (seed, demand) of the
+# jam check; the (EVAL_SEED, tiny's own demand) pair is the main evaluation above. Prints
+# one line per evaluation; returns 1 if one jammed, 2 if one failed to run.
+no_jams() {
+  local policy="$1" main_eval="$2" seed demand dir verdict=0
+  for seed in $JAM_SEEDS; do
+    for demand in $JAM_DEMANDS; do
+      dir="$WORK/jam/s$seed-d$demand"
+      if [ "$seed" = "$EVAL_SEED" ] && [ "$demand" = 1000 ]; then
+        dir="$main_eval"
+      else
+        "$ROOT/palcas" run --policy "$policy" --no-compare --scenario tiny --duration "$JAM_DURATION" --seed "$seed" \
+          --demand "$demand" --out "$dir" >"$WORK/jam-s$seed-d$demand.log" 2>&1 &&
+        "$ROOT/palcas" run --arm keep --no-compare --scenario tiny --duration "$JAM_DURATION" --seed "$seed" \
+          --demand "$demand" --out "$dir" >>"$WORK/jam-s$seed-d$demand.log" 2>&1 || { verdict=2; echo "learning jam check seed $seed demand $demand: the run failed ($WORK/jam-s$seed-d$demand.log)"; continue; }
+      fi
+      local p k
+      read -r _ p < <(outcome "$dir/palcas/metrics.json" 2>/dev/null || echo "nan nan")
+      read -r _ k < <(outcome "$dir/keep/metrics.json" 2>/dev/null || echo "nan nan")
+      if ! is_number "$p" || ! is_number "$k"; then
+        verdict=2; echo "learning jam check seed $seed demand $demand: no metrics (policy '$p', keep '$k')"; continue
+      fi
+      if awk -v p="$p" -v k="$k" -v share="$JAM_SHARE" 'BEGIN { exit !(p < share * k) }'; then
+        [ "$verdict" -eq 2 ] || verdict=1
+        echo "learning jam check seed $seed demand $demand: policy $p m/s < $JAM_SHARE x keep's $k m/s: JAM"
+      else
+        echo "learning jam check seed $seed demand $demand: policy $p m/s, keep $k m/s"
+      fi
+    done
+  done
+  return "$verdict"
+}
+
+# The learnt policy that was judged above (the second training's, if there was one).
+learnt="$WORK/learning"
+[ ! -d "$WORK/learning_again" ] || learnt="$WORK/learning_again"
+if [ -d "$learnt/train/checkpoints" ] && [ -f "$learnt/eval/palcas/metrics.json" ]; then
+  no_jams "$learnt/train" "$learnt/eval"; verdict=$?
+  if [ "$verdict" -eq 0 ]; then
+    record trained_policy_does_not_jam ""
+  elif [ "$verdict" -eq 1 ]; then
+    fail_keeping_work trained_policy_does_not_jam "the policy jammed the road (speed < $JAM_SHARE x keep's on the same seed and demand; lines above; logs: $WORK)"
+  else
+    fail_keeping_work trained_policy_does_not_jam "an evaluation of the jam check failed (logs: $WORK)"
+  fi
+else
+  fail_keeping_work trained_policy_does_not_jam "no trained policy to check (the training failed; logs: $WORK)"
 fi
 
 failed="$(write_junit palcas_learning "$XML")"

@@ -46,6 +46,13 @@ class BagMetricsTest(unittest.TestCase):
         self.assertEqual(check.returncode, 0, check.stderr + check.stdout[-2000:])
         recomputed = json.loads(check.stdout)
         self.assertEqual(recomputed["cavs_seen"], live["cavs_seen"])
+        # The demand figures are recomputed too (compared above, within 1e-9), and not empty.
+        for key in ("throughput_vph", "mean_travel_time_s", "lane_changes_per_cav", "arrived", "cav_lane_changes"):
+            self.assertIn(key, recomputed)
+            self.assertIn(key, live)
+        self.assertGreater(live["arrived"], 10)
+        self.assertGreater(live["mean_travel_time_s"], 0.0)
+        self.assertEqual(recomputed["arrived"], live["arrived"])
         self.assertIn("agree", check.stderr)
 
 

@@ -6,7 +6,9 @@ figure functions (tools/run_figures.py), on fake run folders and a tiny recorded
 
 usage: experiment_tools_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
 import argparse
+import contextlib
 import csv
+import io
 import json
 import math
 import pathlib
@@ -20,6 +22,7 @@ FIXTURE = pathlib.Path(__file__).resolve().parent / "fixtures" / "tiny_run"
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import experiment  # noqa: E402
+import eval_table  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
@@ -28,7 +31,7 @@ from junit_runner import run_as_junit  # noqa: E402
 
 def args(**kw):
     base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
-                policy=None, jobs=1, check_only=False)
+                policy=None, jobs=1, check_only=False, demands=None)
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -93,6 +96,34 @@ class PlannerTest(unittest.TestCase):
                 experiment.settings_from_args(args(**kw))
             self.assertIn(text, str(e.exception))
 
+    def test_demands_are_a_dimension_of_the_points(self):
+        s = experiment.settings_from_args(args(demands="1000,1800"))
+        self.assertEqual(s["demands"], [1000.0, 1800.0])
+        pts = experiment.points_of(s)
+        self.assertEqual(len(pts), 2 * 2 * 2 * 2)
+        self.assertIn("keep_pr60_d1800_s102", {p["name"] for p in pts})
+        self.assertEqual({p["demand"] for p in pts}, {1000.0, 1800.0})
+        # The first seed of every demand records trajectories.
+        self.assertEqual(sum(p["trajectories"] for p in pts), 2 * 2 * 2)
+        # Without --demands: the names and points of before, at the scenario's demand.
+        plain = experiment.points_of(experiment.settings_from_args(args()))
+        self.assertEqual({p["demand"] for p in plain}, {None})
+        self.assertIn("keep_pr60_s102", {p["name"] for p in plain})
+        for bad, text in (("1000,0", "0 is outside"), ("1000,1000", "twice"), ("x", "'x' is not valid"),
+                          ("200000", r"outside \(0, 100000\]")):
+            with self.assertRaisesRegex(experiment.UsageError, text):
+                experiment.settings_from_args(args(demands=bad))
+
+    def test_an_experiment_keeps_its_kind_of_demand(self):
+        experiment.save_settings(self.out, experiment.settings_from_args(args()))
+        with self.assertRaisesRegex(experiment.UsageError, "the scenario's own demand"):
+            experiment.merge_settings(self.out, experiment.settings_from_args(args(demands="1400")))
+        experiment.save_settings(self.out, experiment.settings_from_args(args(demands="1400")))
+        with self.assertRaisesRegex(experiment.UsageError, "--demands 1400"):
+            experiment.merge_settings(self.out, experiment.settings_from_args(args()))
+        merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(demands="1800,1400")))
+        self.assertEqual(merged["demands"], [1400.0, 1800.0])
+
     def test_continuation_extends_but_never_changes_duration(self):
         s = experiment.settings_from_args(args())
         experiment.save_settings(self.out, s)
@@ -103,12 +134,12 @@ class PlannerTest(unittest.TestCase):
         self.assertEqual(merged["prs"], [5.0, 60.0, 40.0])
 
 
-def fake_point(out, name, arm, sim_seconds, status=None, dsr=None):
+def fake_point(out, name, arm, sim_seconds, status=None, dsr=None, speed=20.0, throughput=None):
     d = out / "points" / name
     (d / arm).mkdir(parents=True, exist_ok=True)
     if sim_seconds is not None:
-        m = {"sim_seconds": sim_seconds, "efficiency_all_mps": 20.0, "collision_rate_pct": 0.0,
-             "dsr_pct": dsr, "msr_pct": 100.0, "comfort_share_pct": 80.0}
+        m = {"sim_seconds": sim_seconds, "efficiency_all_mps": speed, "collision_rate_pct": 0.0,
+             "dsr_pct": dsr, "msr_pct": 100.0, "comfort_share_pct": 80.0, "throughput_vph": throughput}
         (d / arm / "metrics.json").write_text(json.dumps(m))
     if status:
         (d / "point.json").write_text(json.dumps({"status": status, "wall_s": 10.0,
@@ -185,6 +216,107 @@ class CollectorTest(unittest.TestCase):
         md = (self.out / "tables.md").read_text()
         self.assertIn("PALCAS, paper", md)
         self.assertIn("*94.0 ± 3.6*", md)
+
+
+class DemandCollectorTest(unittest.TestCase):
+    """Tables per demand, the worst seed beside the mean, JAM against SUMO-native on the same
+    traffic, and the capacity figure."""
+
+    def setUp(self):
+        self.out = pathlib.Path(tempfile.mkdtemp(prefix="palcas_demand_test_"))
+        self.s = experiment.settings_from_args(args(arms="keep,sumo_native", prs="60", seeds=3,
+                                                    demands="1000,1800"))
+        experiment.save_settings(self.out, self.s)
+        self.pts = experiment.points_of(self.s)
+        # SUMO-native 25 m/s at 1000, 20 m/s at 1800; keep the same but seed 102 at 1800
+        # jams (9 < 0.5 x 20) and seed 103 at 1000 is slow but no jam (13 > 12.5).
+        speeds = {("keep", 1000, 101): 24.0, ("keep", 1000, 102): 26.0, ("keep", 1000, 103): 13.0,
+                  ("keep", 1800, 101): 19.0, ("keep", 1800, 102): 9.0, ("keep", 1800, 103): 21.0}
+        for p in self.pts:
+            native = 25.0 if p["demand"] == 1000 else 20.0
+            speed = speeds.get((p["arm"], int(p["demand"]), p["seed"]), native)
+            fake_point(self.out, p["name"], p["arm"], 600.0, "done", dsr=50.0 + p["seed"] - 100,
+                       speed=speed, throughput=3 * p["demand"] * speed / 25.0)
+
+    def tearDown(self):
+        shutil.rmtree(self.out, ignore_errors=True)
+
+    def test_jams_worst_seeds_and_tables_per_demand(self):
+        self.assertEqual(experiment_results.collect(self.out, self.s, self.pts), 0)
+        rows = {r["point"]: r for r in read_csv(self.out / "results.csv")}
+        self.assertEqual(rows["keep_pr60_d1800_s102"]["demand"], "1800.0")
+        self.assertEqual(rows["keep_pr60_d1800_s102"]["jam"], "yes")
+        self.assertEqual(rows["keep_pr60_d1000_s103"]["jam"], "no")
+        self.assertEqual(rows["sumo_native_pr60_d1000_s101"]["jam"], "no")
+        speed = {(r["arm"], r["demand"]): r for r in read_csv(self.out / "table_efficiency_all_mps.csv")}
+        self.assertEqual(len(speed), 4)  # 2 arms x 2 demands at one PR
+        self.assertAlmostEqual(float(speed[("keep", "1800")]["mean"]), (19.0 + 9.0 + 21.0) / 3, places=4)
+        self.assertEqual((speed[("keep", "1800")]["worst"], speed[("keep", "1800")]["worst_seed"]), ("9.0", "102"))
+        self.assertEqual(speed[("keep", "1800")]["jam_seeds"], "102")
+        self.assertEqual(speed[("keep", "1000")]["jam_seeds"], "")
+        dsr = {(r["arm"], r["demand"]): r for r in read_csv(self.out / "table_dsr_pct.csv")}
+        self.assertEqual((dsr[("keep", "1000")]["worst"], dsr[("keep", "1000")]["worst_seed"]), ("51.0", "101"))
+        md = (self.out / "tables.md").read_text()
+        self.assertIn("### demand 1000 veh/h/lane", md)
+        self.assertIn("### demand 1800 veh/h/lane", md)
+        self.assertIn("(worst 9.00, s102) **JAM** (s102)", md)
+        self.assertIn("**JAM** (1 point(s) below 0.5 x SUMO-native's speed on the same traffic): "
+                      "keep_pr60_d1800_s102 (9.00 m/s)", md)
+        self.assertIn("(worst 13.00, s103)", md)
+
+    def test_capacity_figure_has_a_line_per_arm_over_demand(self):
+        experiment_results.collect(self.out, self.s, self.pts)
+        self.assertGreater((self.out / "figures" / "capacity.png").stat().st_size, 10000)
+        cap = {(r["arm"], r["demand"], r["metric"]): r for r in read_csv(self.out / "figures" / "capacity.csv")}
+        self.assertEqual(len(cap), 2 * 2 * 2)  # arms x demands x (speed, throughput)
+        native = cap[("sumo_native", "1800", "efficiency_all_mps")]
+        self.assertEqual((native["n"], float(native["mean"]), float(native["ci95_half"])), ("3", 20.0, 0.0))
+        keep = cap[("keep", "1000", "throughput_vph")]
+        self.assertAlmostEqual(float(keep["mean"]), 3 * 1000 * (24.0 + 26.0 + 13.0) / 3 / 25.0, places=3)
+        self.assertGreater(float(keep["ci95_half"]), 0.0)
+
+    def test_without_sumo_native_jams_are_not_checked_and_old_folders_still_collect(self):
+        s = experiment.settings_from_args(args(arms="keep", prs="60", seeds=2))  # no --demands
+        out = self.out / "old"
+        experiment.save_settings(out, s)
+        pts = experiment.points_of(s)
+        for p in pts:
+            fake_point(out, p["name"], "keep", 600.0, "done", dsr=40.0, speed=5.0)
+        self.assertEqual(experiment_results.collect(out, s, pts), 0)
+        rows = read_csv(out / "results.csv")
+        self.assertEqual({r["demand"] for r in rows}, {"1000.0"})  # the tiny scenario's own
+        self.assertEqual({r["jam"] for r in rows}, {""})
+        self.assertIn("Jams not checked: no sumo_native arm", (out / "tables.md").read_text())
+        self.assertFalse((out / "figures" / "capacity.png").exists())
+        # A results.csv from before the demand column merges at the scenario's demand.
+        old_csv = out / "old_results.csv"
+        with open(old_csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=[k for k in rows[0] if k not in ("demand", "jam")])
+            w.writeheader()
+            for r in rows:
+                w.writerow({k: v for k, v in r.items() if k in w.fieldnames})
+        merged = experiment_results.merge(out / "merged", [old_csv], [101, 102], 600.0, "tiny")
+        self.assertEqual({r["demand"] for r in merged}, {1000.0})
+        self.assertEqual(read_csv(out / "merged" / "table_dsr_pct.csv")[0]["demand"], "1000")
+
+
+class EvalTableTest(unittest.TestCase):
+    def test_worst_run_and_jams_against_sumo_native_of_the_same_run(self):
+        base = pathlib.Path(tempfile.mkdtemp(prefix="palcas_eval_test_"))
+        for run, keep_speed in (("run-s101", 22.0), ("run-s102", 9.0)):
+            for arm, speed in (("keep", keep_speed), ("sumo_native", 20.0)):
+                (base / run / arm).mkdir(parents=True)
+                (base / run / arm / "metrics.json").write_text(json.dumps(
+                    {"efficiency_all_mps": speed, "dsr_pct": 40.0 if run == "run-s101" else 60.0}))
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            eval_table.main([str(base / "run-s101"), str(base / "run-s102")])
+        out = text.getvalue()
+        self.assertIn("(worst 9.00, run-s102) **JAM**", out)
+        self.assertIn("(worst 40.0, run-s101)", out)
+        self.assertIn("JAM: keep in run-s102: 9.00 m/s < 0.5 x sumo_native's 20.00 m/s", out)
+        self.assertNotIn("JAM: sumo_native", out)
+        shutil.rmtree(base, ignore_errors=True)
 
 
 class FiguresTest(unittest.TestCase):

@@ -4,6 +4,8 @@ options a resumed training settles on, the training record, and how a console lo
 (nodes that died for good, why a simulation ended early); and of tools/ship_policy.py.
 
 usage: train_tool_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
+import contextlib
+import io
 import json
 import os
 import pathlib
@@ -18,7 +20,7 @@ import ship_policy  # noqa: E402
 import train  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
-NOT_GIVEN = dict(arm=None, episodes=None, duration=None, pr=None, seed=None, scenario=None, explore_fraction=None)
+NOT_GIVEN = {k: None for k in train.ALL_GIVEN}
 RECORD = {"arm": "independent", "scenario": "tiny", "pr": 40, "seed": 3, "episodes": 4, "duration_s": 300,
           "learning": "/x/learning_schedule.yaml", "rsu_params": "", "bridge_params": "/b.yaml",
           "paper_printed": False, "explore_fraction": 0.4, "git_commit": "abc"}
@@ -93,6 +95,145 @@ class Record(unittest.TestCase):
         self.assertEqual(len(first), 64)
         self.assertEqual(os.stat(key).st_mode & 0o777, 0o600)
         self.assertEqual(open(train.message_key(out)).read(), first)
+
+
+class DemandAndRanges(unittest.TestCase):
+    """--demand / --ramp-demand for every episode, --demand-range / --pr-range drawn per
+    episode from the training seed, recorded in train.json, one launch per drawn episode."""
+
+    def opts(self, **kw):
+        o = dict(train.DEFAULTS, seed=7, episodes=6, demand_range=[1000, 2200], pr_range=[20, 60])
+        o.update(kw)
+        return o
+
+    def test_draws_are_uniform_in_the_ranges_and_follow_from_seed_and_episode(self):
+        draws = [train.episode_draw(self.opts(), k) for k in range(200)]
+        self.assertTrue(all(1000 <= d["demand_vphpl"] <= 2200 and 20 <= d["pr"] <= 60 for d in draws))
+        self.assertEqual([d["seed"] for d in draws[:3]], [7, 8, 9])  # episode k: seed + k
+        # Spread over the range (uniform: 200 draws reach both ends' tenths), not one value.
+        self.assertLess(min(d["demand_vphpl"] for d in draws), 1120)
+        self.assertGreater(max(d["demand_vphpl"] for d in draws), 2080)
+        self.assertGreater(len({d["pr"] for d in draws}), 150)
+        # The same training seed and episode: the same draw, in whatever order asked.
+        self.assertEqual(train.episode_draw(self.opts(), 5), draws[5])
+        self.assertNotEqual(train.episode_draw(self.opts(seed=8), 5), draws[5])
+
+    def test_without_ranges_every_episode_has_the_given_or_the_scenarios_values(self):
+        d = train.episode_draw(self.opts(demand_range=None, pr_range=None, demand=1400.0, pr=40.0), 3)
+        self.assertEqual((d["demand_vphpl"], d["pr"]), (1400, 40))
+        d = train.episode_draw(self.opts(demand_range=None, demand=None), 3)
+        self.assertIsNone(d["demand_vphpl"])  # the scenario's
+        self.assertTrue(20 <= d["pr"] <= 60)
+
+    def test_the_record_holds_ranges_and_every_episodes_draw(self):
+        out = tempfile.mkdtemp()
+        opts = self.opts(learning="", rsu_params="", bridge_params="", paper_printed=False, ramp_demand=450.0)
+        train.write_record(out, opts, "abc")
+        with open(os.path.join(out, "train.json")) as f:
+            record = json.load(f)
+        self.assertEqual((record["demand_range"], record["pr_range"], record["ramp_demand_vph"]),
+                         ([1000, 2200], [20, 60], 450))
+        self.assertIsNone(record["demand_vphpl"])
+        self.assertEqual(record["episode_draws"], [train.episode_draw(opts, k) for k in range(6)])
+        plain = dict(opts, demand_range=None, pr_range=None, demand=1800.0)
+        train.write_record(out, plain, "abc")
+        with open(os.path.join(out, "train.json")) as f:
+            record = json.load(f)
+        self.assertEqual(record["demand_vphpl"], 1800)
+        self.assertNotIn("episode_draws", record)
+
+    def test_resume_keeps_the_recorded_demand_and_refuses_another(self):
+        out = tempfile.mkdtemp()
+        with open(os.path.join(out, "train.json"), "w") as f:
+            json.dump(dict(RECORD, demand_vphpl=None, ramp_demand_vph=None, demand_range=[1000, 2000],
+                           pr_range=None), f)
+        opts, _ = train.settle_options(given(), out, resume=True)
+        self.assertEqual((opts["demand_range"], opts["demand"]), ([1000, 2000], None))
+        with self.assertRaisesRegex(train.OptionError, "trained with --demand-range 1000,2000, not --demand-range 1000,2200"):
+            train.settle_options(given(demand_range=[1000, 2200]), out, resume=True)
+        with self.assertRaisesRegex(train.OptionError, r"trained with --demand \(the scenario's\), not --demand 1400"):
+            train.settle_options(given(demand=1400.0), out, resume=True)
+        # A record from before demand was an option: the scenario's demand, no ranges.
+        opts, _ = train.settle_options(given(), self.old_record(), resume=True)
+        self.assertEqual((opts["demand"], opts["demand_range"], opts["pr_range"]), (None, None, None))
+
+    def old_record(self):
+        out = tempfile.mkdtemp()
+        with open(os.path.join(out, "train.json"), "w") as f:
+            json.dump(RECORD, f)
+        return out
+
+    def test_bad_ranges_are_refused_naming_the_option(self):
+        for argv, text in ((["--demand-range", "2000,1000"], "--demand-range '2000,1000': MIN 2000 is greater than MAX 1000"),
+                           (["--demand-range", "1000"], "--demand-range '1000': expected MIN,MAX"),
+                           (["--pr-range", "10,200"], r"--pr-range '10,200': expected MIN,MAX, two numbers in \[0, 100\]"),
+                           (["--demand", "1000", "--demand-range", "1000,2000"], "--demand and --demand-range"),
+                           (["--pr", "40", "--pr-range", "10,20"], "--pr and --pr-range")):
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                status = train.main(["--root", str(ROOT), "--check-only"] + argv)
+            self.assertEqual(status, 2, argv)
+            self.assertRegex(err.getvalue(), text)
+
+    def launches(self, opts):
+        """run_launches with a stand-in roslaunch that finishes the episodes it is given:
+        the argument list of every launch."""
+        out = tempfile.mkdtemp()
+        calls = []
+
+        class FakeProcess:
+            def __init__(self, cmd, **_):
+                self.cmd = cmd
+                if "roslaunch" in cmd:
+                    calls.append(cmd[cmd.index("system.launch") + 1:])
+                    n = int([a for a in cmd if a.startswith("episodes:=")][0].split(":=")[1])
+                    path = os.path.join(out, "episodes.csv")
+                    fresh = not os.path.exists(path)
+                    with open(path, "a") as f:
+                        f.write("episode\n" if fresh else "")
+                        f.write("x\n" * n)
+
+            def wait(self):
+                return 0
+
+            def poll(self):
+                return 0
+
+            def terminate(self):
+                pass
+
+        class Args:
+            resume = False
+            command_line = "test"
+
+        real = train.subprocess.Popen
+        train.subprocess.Popen = FakeProcess
+        try:
+            status = train.run_launches(str(ROOT), out, opts, {"git_commit": "x"}, Args(), train.Interrupt())
+        finally:
+            train.subprocess.Popen = real
+        self.assertEqual(status, 0)
+        return [dict(a.split(":=", 1) for a in c) for c in calls]
+
+    def test_drawn_episodes_each_get_their_own_launch_with_their_draw(self):
+        opts = self.opts(episodes=3, scenario="tiny", duration=30.0)
+        calls = self.launches(opts)
+        self.assertEqual(len(calls), 3)
+        for k, c in enumerate(calls):
+            draw = train.episode_draw(opts, k)
+            self.assertEqual((c["episodes"], c["first_episode"]), ("1", str(k)))
+            self.assertEqual((float(c["demand"]), float(c["pr"])), (draw["demand_vphpl"], draw["pr"]))
+            self.assertEqual(c["ramp_demand"], "scenario")
+            self.assertEqual(c["resume"], "true" if k > 0 else "false")
+
+    def test_a_fixed_demand_keeps_one_launch_for_every_episode(self):
+        calls = self.launches(self.opts(episodes=3, scenario="tiny", duration=30.0, demand_range=None,
+                                        pr_range=None, demand=1400.0, ramp_demand=500.0, pr=40.0))
+        self.assertEqual(len(calls), 1)
+        self.assertEqual((calls[0]["episodes"], calls[0]["demand"], calls[0]["ramp_demand"], calls[0]["pr"]),
+                         ("3", "1400", "500", "40"))
+        calls = self.launches(self.opts(episodes=2, scenario="tiny", duration=30.0, demand_range=None, pr_range=None))
+        self.assertEqual(calls[0]["demand"], "scenario")
 
 
 class ConsoleLog(unittest.TestCase):

@@ -52,6 +52,7 @@ struct RunSummary {
   std::uint64_t vanished_vehicles = 0;  ///< tracked vehicles SUMO no longer knew
   std::uint64_t route_changes_failed = 0;  ///< exit route changes SUMO refused
   sim::GuardCounters guard;  ///< how often the advice guard acted
+  std::uint64_t insertion_dropped = 0;  ///< vehicles SUMO dropped at insertion (max_depart_delay_s)
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

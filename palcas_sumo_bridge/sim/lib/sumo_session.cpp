@@ -135,7 +135,8 @@ SumoSession::SumoSession(const SessionOptions& options) : options_(options) {
   time_s_ = api::Simulation::getTime();
   const std::vector<int> sim_vars{
       libsumo::VAR_DEPARTED_VEHICLES_IDS, libsumo::VAR_ARRIVED_VEHICLES_IDS,
-      libsumo::VAR_COLLIDING_VEHICLES_IDS, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS};
+      libsumo::VAR_COLLIDING_VEHICLES_IDS, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS,
+      libsumo::VAR_LOADED_VEHICLES_NUMBER};
   api::Simulation::subscribe(sim_vars);
   readNetwork();
 }
@@ -201,6 +202,15 @@ void SumoSession::readNetwork() {
 
 int SumoSession::minExpectedVehicles() const { return api::Simulation::getMinExpectedNumber(); }
 
+std::uint64_t SumoSession::insertionDropped() const {
+  // SUMO 1.15 has no count of its own (MSVehicleControl's discarded count is not in the
+  // API): every vehicle it built from a flow (loaded) either departed, still waits in the
+  // insertion queue (pending), or was dropped after waiting max-depart-delay.
+  const std::uint64_t waiting = api::Simulation::getPendingVehicles().size();
+  const std::uint64_t accounted = departed_vehicles_ + waiting;
+  return loaded_vehicles_ > accounted ? loaded_vehicles_ - accounted : 0;
+}
+
 std::string SumoSession::sumoVersion() const { return api::Simulation::getVersion().second; }
 
 const VehicleRecord* SumoSession::find(const std::string& id) const {
@@ -233,6 +243,9 @@ const StepEvents& SumoSession::step() {
   events_.arrived = asStringList(sim, libsumo::VAR_ARRIVED_VEHICLES_IDS);
   events_.collided = asStringList(sim, libsumo::VAR_COLLIDING_VEHICLES_IDS);
   events_.teleported = asStringList(sim, libsumo::VAR_TELEPORT_STARTING_VEHICLES_IDS);
+  const double loaded = asDouble(sim, libsumo::VAR_LOADED_VEHICLES_NUMBER);
+  if (loaded > 0.0) loaded_vehicles_ += static_cast<std::uint64_t>(loaded);
+  departed_vehicles_ += events_.departed.size();
   // A vehicle colliding on two lanes at once is listed twice.
   std::sort(events_.collided.begin(), events_.collided.end());
   events_.collided.erase(std::unique(events_.collided.begin(), events_.collided.end()),

@@ -207,6 +207,9 @@ class SumoSession {
   const GuardCounters& guardCounters() const { return guard_; }
   /// The guard's floor for this CAV [m/s] (0 when the guard is off).
   double guardFloorMps(const VehicleRecord& v) const;
+  /// Vehicles SUMO dropped at insertion so far: loaded from a flow, never departed, no
+  /// longer waiting (they waited longer than --max-depart-delay). Asks SUMO.
+  std::uint64_t insertionDropped() const;
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -249,6 +252,7 @@ class SumoSession {
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
   std::uint64_t route_changes_failed_ = 0;
   GuardCounters guard_;
+  std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;
