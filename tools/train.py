@@ -313,6 +313,23 @@ class Interrupt:
             self.launch.send_signal(signal.SIGINT)
 
 
+def keep_episode_metrics(out, episode):
+    """A launch of episode 0 alone writes only <out>/metrics.json (the bridge keeps
+    episode_<k>/ for launches of several episodes or later ones): copied to episode_0/, as
+    every other episode of a training has its own."""
+    src, dest = os.path.join(out, "metrics.json"), os.path.join(out, "episode_%d" % episode, "metrics.json")
+    try:
+        with open(src) as f:
+            text = f.read()
+        if os.path.exists(dest) or json.loads(text).get("episode") != episode:
+            return
+    except (OSError, ValueError):
+        return
+    os.makedirs(os.path.dirname(dest), exist_ok=True)
+    with open(dest, "w") as f:
+        f.write(text)
+
+
 def run_launches(root, out, opts, record, args, interrupt):
     """The launch loop: one roslaunch for the episodes left (one per episode when demand or
     PR is drawn per episode); a simulation that died ends that episode only (the nodes
@@ -387,6 +404,8 @@ def run_launches(root, out, opts, record, args, interrupt):
                 f.write("launch %d: lost %s; episodes.csv rows %d..%d were run without it\n"
                         % (launches, ", ".join(lost), rows_before + 1, rows_after))
             return 1
+        if sampled(opts) and rows_after > rows_before:
+            keep_episode_metrics(out, nxt)
         nxt += rows_after - rows_before
         short = rows_after - rows_before < count  # this launch did not finish its episodes
         if short and status in (130, 143):  # roslaunch itself was interrupted

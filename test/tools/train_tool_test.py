@@ -113,6 +113,8 @@ class DemandAndRanges(unittest.TestCase):
         # Spread over the range (uniform: 200 draws reach both ends' tenths), not one value.
         self.assertLess(min(d["demand_vphpl"] for d in draws), 1120)
         self.assertGreater(max(d["demand_vphpl"] for d in draws), 2080)
+        self.assertLess(min(d["pr"] for d in draws), 23)
+        self.assertGreater(max(d["pr"] for d in draws), 57)
         self.assertGreater(len({d["pr"] for d in draws}), 150)
         # The same training seed and episode: the same draw, in whatever order asked.
         self.assertEqual(train.episode_draw(self.opts(), 5), draws[5])
@@ -187,6 +189,9 @@ class DemandAndRanges(unittest.TestCase):
                 if "roslaunch" in cmd:
                     calls.append(cmd[cmd.index("system.launch") + 1:])
                     n = int([a for a in cmd if a.startswith("episodes:=")][0].split(":=")[1])
+                    first = int([a for a in cmd if a.startswith("first_episode:=")][0].split(":=")[1])
+                    with open(os.path.join(out, "metrics.json"), "w") as f:  # what the bridge writes
+                        json.dump({"episode": first + n - 1}, f)
                     path = os.path.join(out, "episodes.csv")
                     fresh = not os.path.exists(path)
                     with open(path, "a") as f:
@@ -213,6 +218,7 @@ class DemandAndRanges(unittest.TestCase):
         finally:
             train.subprocess.Popen = real
         self.assertEqual(status, 0)
+        self.out = out
         return [dict(a.split(":=", 1) for a in c) for c in calls]
 
     def test_drawn_episodes_each_get_their_own_launch_with_their_draw(self):
@@ -225,6 +231,9 @@ class DemandAndRanges(unittest.TestCase):
             self.assertEqual((float(c["demand"]), float(c["pr"])), (draw["demand_vphpl"], draw["pr"]))
             self.assertEqual(c["ramp_demand"], "scenario")
             self.assertEqual(c["resume"], "true" if k > 0 else "false")
+        # Episode 0 ran alone: its metrics.json is kept in episode_0/ like the others'.
+        with open(os.path.join(self.out, "episode_0", "metrics.json")) as f:
+            self.assertEqual(json.load(f)["episode"], 0)
 
     def test_a_fixed_demand_keeps_one_launch_for_every_episode(self):
         calls = self.launches(self.opts(episodes=3, scenario="tiny", duration=30.0, demand_range=None,
