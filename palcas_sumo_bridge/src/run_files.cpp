@@ -122,6 +122,10 @@ json bridgeJson(const BridgeOptions& o) {
           {"lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2},
           {"lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2},
           {"guard_floor_speed_share", o.session.guard_floor_speed_share},
+          {"guard_lane_change_cooldown_s", o.session.guard_lane_change_cooldown_s},
+          {"guard_busy_speed_share", o.session.guard_busy_speed_share},
+          {"guard_busy_leave_share", o.session.guard_busy_leave_share},
+          {"guard_busy_window_s", o.session.guard_busy_window_s},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
@@ -236,7 +240,14 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"accelerate_guarded_pct", share(g.accelerate_floored_steps + g.accelerate_released_steps, g.accelerate_steps)},
           {"lane_change_cav_s", dt * g.lane_change_steps},
           {"lane_change_released_cav_s", dt * g.lane_change_released_steps},
-          {"lane_change_guarded_pct", share(g.lane_change_released_steps, g.lane_change_steps)}};
+          {"lane_change_guarded_pct", share(g.lane_change_released_steps, g.lane_change_steps)},
+          {"lane_change_cooldown_s", o.session.guard_lane_change_cooldown_s},
+          {"lane_changes_advised", g.lane_changes_advised},
+          {"lane_changes_cooled_down", g.lane_changes_cooled_down},
+          {"busy_speed_share", o.session.guard_busy_speed_share},
+          {"lane_changes_busy_refused", g.lane_changes_busy_refused},
+          {"busy_zone_pct", share(g.busy_zone_steps, g.zone_steps)},
+          {"busy_zone_s", o.scenario.step_length_s * g.busy_zone_steps}};
 }
 
 void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {

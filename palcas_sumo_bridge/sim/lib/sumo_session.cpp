@@ -278,7 +278,44 @@ const StepEvents& SumoSession::step() {
     onDeparted(id);
   }
   readVehicles();
+  updateZones();
   return events_;
+}
+
+void SumoSession::updateZones() {
+  if (options_.guard_busy_speed_share <= 0.0) return;
+  const std::size_t n = road_->clusters().size();
+  if (zone_speed_share_.size() != n) {
+    zone_speed_share_.assign(n, 1.0);  // an empty road is free
+    zone_busy_.assign(n, false);
+  }
+  std::vector<double> sum(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (const VehicleRecord& v : vehicles_) {
+    if (v.part != RoadPart::kMainline || v.lane < 1 || v.max_speed_mps <= 0.0) continue;
+    const int k = static_cast<int>(v.x_m / options_.cluster_length_m);
+    if (k < 0 || k >= static_cast<int>(n)) continue;
+    sum[k] += std::min(1.0, v.speed_mps / v.max_speed_mps);
+    ++count[k];
+  }
+  // Exponential smoothing over the window: one jam-free gap or one slow car does not flip it.
+  const double alpha = std::min(1.0, step_length_s_ / std::max(step_length_s_, options_.guard_busy_window_s));
+  const double leave = std::max(options_.guard_busy_leave_share, options_.guard_busy_speed_share);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (count[k] > 0) zone_speed_share_[k] += alpha * (sum[k] / count[k] - zone_speed_share_[k]);
+    if (zone_speed_share_[k] < options_.guard_busy_speed_share) zone_busy_[k] = true;
+    else if (zone_speed_share_[k] > leave) zone_busy_[k] = false;
+    ++guard_.zone_steps;
+    if (zone_busy_[k]) ++guard_.busy_zone_steps;
+  }
+}
+
+bool SumoSession::zoneBusy(int cluster) const {
+  return cluster >= 0 && cluster < static_cast<int>(zone_busy_.size()) && zone_busy_[cluster];
+}
+
+double SumoSession::zoneSpeedShare(int cluster) const {
+  return cluster >= 0 && cluster < static_cast<int>(zone_speed_share_.size()) ? zone_speed_share_[cluster] : 1.0;
 }
 
 void SumoSession::removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed) {
@@ -475,6 +512,7 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
   if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
     // Done, or dropped after lane_change_duration_s (no safe gap found in time).
     ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
+    if (v.lane == v.lane_change_target) v.last_lane_change_s = time_s_;
     v.lane_change_target = 0;
     restoreLaneChangeAcceleration(v);
     return;
@@ -510,6 +548,19 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     if (!on_junction && road_->sumoLaneIndex(v.edge, target_lane) < 0)
       throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
                                   "' has no lane " + std::to_string(target_lane));
+    ++guard_.lane_changes_advised;
+    const bool serves_route = (action == LANE_RIGHT && std::isfinite(v.distance_to_exit_m)) ||
+                              (action == LANE_LEFT && v.on_accel_lane);
+    const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
+    const bool busy = zoneBusy(static_cast<int>(v.x_m / options_.cluster_length_m));
+    if (!serves_route && v.lane_change_target == 0 && (cooling || busy)) {
+      // Weaving for no need of its own route: moments after its last change, or where the
+      // road is busy.
+      ++(busy ? guard_.lane_changes_busy_refused : guard_.lane_changes_cooled_down);
+      v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
+      v.command_value = v.speed_mps;
+      return;
+    }
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
     updateLaneChangeBound(v);

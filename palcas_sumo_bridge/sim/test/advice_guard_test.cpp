@@ -3,11 +3,13 @@
 // bound holding CAVs below what their own car following would do: a queued CAV advised a
 // small positive acceleration left the queue at that rate, not its own, so a queue drained
 // slower than it filled. With the guard a CAV below the floor drives itself, and advice
-// cannot brake a CAV below the floor. One libsumo simulation per process: one test.
+// cannot brake a CAV below the floor; and a CAV that just changed lanes is not sent back for
+// no need of its route (the cooldown). One libsumo simulation per process: one test.
 #include <gtest/gtest.h>
 #include <libsumo/libsumo.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "palcas_sim/sumo_session.h"
 #include "scenario_test_util.h"
@@ -18,7 +20,7 @@ using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
 
 namespace {
-constexpr int LANE_LEFT = 0, ACCELERATE = 2;
+constexpr int LANE_LEFT = 0, LANE_RIGHT = 1, ACCELERATE = 2;
 constexpr double FLOOR_SHARE = 0.6;
 
 // A mainline CAV in lane 1 or 2 (it can be advised LEFT) with nobody within 100 m ahead of it, or only a fast leader more
@@ -50,6 +52,10 @@ TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
   SessionOptions options = palcas::sim::test::sessionOnTiny("advice_guard", 5);
   options.guard_floor_speed_share = FLOOR_SHARE;
   options.lane_change_max_accel_mps2 = 1.0;  // an advised change's bound, lifted when slow
+  options.guard_lane_change_cooldown_s = 10.0;
+  options.guard_busy_speed_share = 0.3;  // part 5: busy below 30 % of their top speeds
+  options.guard_busy_leave_share = 0.5;
+  options.guard_busy_window_s = 1.0;
   SumoSession session(options);
 
   // 1. Braking advice stops at the floor: -1.47 m/s^2 held for 12 s would take a CAV from
@@ -106,4 +112,65 @@ TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
   EXPECT_DOUBLE_EQ(libsumo::Vehicle::getAccel(fast), 1.0) << "a fast CAV's change is bounded";
   EXPECT_GE(session.guardCounters().lane_change_steps,
             session.guardCounters().lane_change_released_steps);
+
+  // 4. The cooldown: a CAV that just changed lanes is not sent back for no need of its route
+  // (weaving); a change towards its exit still goes through.
+  auto changeLeft = [&](bool exiting) -> std::string {
+    for (int tries = 0; tries < 40; ++tries) {
+      std::string id;
+      for (int i = 0; i < 3000 && id.empty(); ++i) {
+        session.step();
+        for (const VehicleRecord& v : session.vehicles())
+          if (v.part == RoadPart::kMainline && v.lane == 1 && v.x_m > 20.0 && v.x_m < 120.0 &&
+              v.lane_change_target == 0 && v.id != slow && v.id != fast && v.id != braker &&
+              std::isfinite(v.distance_to_exit_m) == exiting && v.distance_to_exit_m > 150.0)
+            id = v.id;
+      }
+      if (id.empty()) return "";
+      session.applyAdvisory(id, LANE_LEFT, 0.0);
+      for (int i = 0; i < 25 && session.find(id) && session.find(id)->lane != 2; ++i) session.step();
+      if (!session.find(id) || session.find(id)->lane != 2) continue;  // no gap: another one
+      session.step();  // the change is seen done
+      if (session.find(id)) return id;
+    }
+    return "";
+  };
+  const std::string through = changeLeft(false);
+  ASSERT_FALSE(through.empty()) << "no through CAV changed to lane 2";
+  const auto before = session.guardCounters().lane_changes_cooled_down;
+  session.applyAdvisory(through, LANE_RIGHT, 0.0);
+  EXPECT_EQ(session.find(through)->lane_change_target, 0) << "sent back within the cooldown";
+  EXPECT_EQ(session.guardCounters().lane_changes_cooled_down, before + 1);
+  const std::string exiting = changeLeft(true);
+  ASSERT_FALSE(exiting.empty()) << "no exiting CAV changed to lane 2";
+  session.applyAdvisory(exiting, LANE_RIGHT, 0.0);
+  EXPECT_EQ(session.find(exiting)->lane_change_target, 1) << "its way to the exit was refused";
+  EXPECT_EQ(session.guardCounters().lane_changes_cooled_down, before + 1);
+
+  // 5. A busy zone: its traffic slowed to a crawl (the test slows every vehicle in zone 0),
+  // a through CAV's change for speed gain is not carried out there, an exiting one's is.
+  for (int i = 0; i < 60; ++i) {
+    for (const VehicleRecord& v : session.vehicles())
+      if (v.part == RoadPart::kMainline && v.x_m < 300.0) libsumo::Vehicle::slowDown(v.id, 2.0, 0.5);
+    session.step();
+  }
+  EXPECT_TRUE(session.zoneBusy(0)) << "zone 0 at 2 m/s is not busy: share " << session.zoneSpeedShare(0);
+  EXPECT_FALSE(session.zoneBusy(1)) << "zone 1 was not slowed: share " << session.zoneSpeedShare(1);
+  std::string slow_through, slow_exiting;
+  for (const VehicleRecord& v : session.vehicles()) {
+    if (v.part != RoadPart::kMainline || v.x_m >= 280.0 || v.lane_change_target != 0 || v.lane < 2) continue;
+    if (!std::isfinite(v.distance_to_exit_m) && slow_through.empty()) slow_through = v.id;
+    if (std::isfinite(v.distance_to_exit_m) && slow_exiting.empty()) slow_exiting = v.id;
+  }
+  ASSERT_FALSE(slow_through.empty() || slow_exiting.empty()) << "no through and exiting CAVs in lanes 2-3 of zone 0";
+  const auto refused = session.guardCounters().lane_changes_busy_refused;
+  if (session.find(slow_through)->lane < 3) {
+    session.applyAdvisory(slow_through, LANE_LEFT, 0.0);
+    EXPECT_EQ(session.find(slow_through)->lane_change_target, 0) << "weaving in a busy zone";
+    EXPECT_EQ(session.guardCounters().lane_changes_busy_refused, refused + 1);
+  }
+  session.applyAdvisory(slow_exiting, LANE_RIGHT, 0.0);
+  EXPECT_EQ(session.find(slow_exiting)->lane_change_target, session.find(slow_exiting)->lane - 1)
+      << "its way to the exit was refused in a busy zone";
+  EXPECT_GT(session.guardCounters().busy_zone_steps, 0u);
 }

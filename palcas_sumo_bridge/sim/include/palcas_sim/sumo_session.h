@@ -75,6 +75,19 @@ struct SessionOptions {
   /// acceleration bound lifted, so it leaves a queue at its own car following's rate. 0 = off
   /// (the paper: the advised acceleration always reaches the car).
   double guard_floor_speed_share = 0.6;
+  /// The advice guard's lane-change cooldown [s]: after an advised change, another advised
+  /// change that does not serve the CAV's route (a RIGHT towards its exit, a LEFT off the
+  /// acceleration lane) is not carried out for this long; the CAV keeps its lane and its own
+  /// driving (as under KEEP). Bounds the weaving an advisory policy can cause. 0 = off.
+  double guard_lane_change_cooldown_s = 0.0;
+  /// The advice guard in busy traffic: a zone whose mainline vehicles drive, on average over
+  /// the last guard_busy_window_s, below this share of their own top speeds is busy until
+  /// that share is back above guard_busy_leave_share. In a busy zone an advised change that
+  /// does not serve the CAV's route is not carried out (the CAV keeps its lane, as under
+  /// KEEP): weaving for speed gain costs a busy road more than it gains. 0 = off.
+  double guard_busy_speed_share = 0.0;
+  double guard_busy_leave_share = 0.0;
+  double guard_busy_window_s = 30.0;
   /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
   /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
   /// lane-change model makes its own strategic, cooperative and speed-gain changes
@@ -95,6 +108,11 @@ struct GuardCounters {
   std::uint64_t accelerate_released_steps = 0;///< ... driven by its own model (below the floor)
   std::uint64_t lane_change_steps = 0;        ///< CAV steps with an advised change under way
   std::uint64_t lane_change_released_steps = 0;///< ... with the acceleration bound lifted
+  std::uint64_t lane_changes_advised = 0;       ///< advised changes received
+  std::uint64_t lane_changes_cooled_down = 0;   ///< ... not carried out (cooldown)
+  std::uint64_t lane_changes_busy_refused = 0;  ///< ... not carried out (busy zone)
+  std::uint64_t busy_zone_steps = 0;            ///< zone steps a zone was busy (all zones)
+  std::uint64_t zone_steps = 0;                 ///< zone steps in all (zones x steps)
 };
 
 /// One vehicle on the road, updated every step.
@@ -142,6 +160,8 @@ struct VehicleRecord {
   std::string lane_change_edge;     ///< edge the request was last issued on
   /// The vehicle's own accel / decel while an advised change bounds them (restored after).
   bool lane_change_bounded = false;
+  /// Simulation time the last advised change was made (-inf: none yet), for the cooldown.
+  double last_lane_change_s = -1e18;
   double own_accel_mps2 = 0.0, own_decel_mps2 = 0.0;
 };
 
@@ -207,6 +227,10 @@ class SumoSession {
   const GuardCounters& guardCounters() const { return guard_; }
   /// The guard's floor for this CAV [m/s] (0 when the guard is off).
   double guardFloorMps(const VehicleRecord& v) const;
+  /// Whether zone k is busy now (always false with guard_busy_speed_share 0).
+  bool zoneBusy(int cluster) const;
+  /// Zone k's smoothed mean of speed / own top speed of its mainline vehicles.
+  double zoneSpeedShare(int cluster) const;
   /// Vehicles SUMO dropped at insertion so far: loaded from a flow, never departed, no
   /// longer waiting (they waited longer than --max-depart-delay). Asks SUMO.
   std::uint64_t insertionDropped() const;
@@ -252,6 +276,10 @@ class SumoSession {
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
   std::uint64_t route_changes_failed_ = 0;
   GuardCounters guard_;
+  /// Per zone: smoothed speed share of its mainline vehicles, and whether it is busy.
+  std::vector<double> zone_speed_share_;
+  std::vector<bool> zone_busy_;
+  void updateZones();
   std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
 };
 
