@@ -126,6 +126,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"guard_busy_speed_share", o.session.guard_busy_speed_share},
           {"guard_busy_leave_share", o.session.guard_busy_leave_share},
           {"guard_busy_window_s", o.session.guard_busy_window_s},
+          {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},

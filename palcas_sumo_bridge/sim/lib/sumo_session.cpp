@@ -523,8 +523,12 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
 }
 
 double SumoSession::guardFloorMps(const VehicleRecord& v) const {
-  if (options_.guard_floor_speed_share <= 0.0) return 0.0;
-  return options_.guard_floor_speed_share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
+  // In a busy zone the floor is the allowed speed itself: advice slows nobody there, the
+  // zone's CAVs drive themselves (only route-serving lane changes are still carried out).
+  const bool busy = zoneBusy(static_cast<int>(v.x_m / options_.cluster_length_m));
+  const double share = busy ? options_.guard_busy_floor_speed_share : options_.guard_floor_speed_share;
+  if (share <= 0.0) return 0.0;
+  return share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
 }
 
 void SumoSession::updateLaneChangeBound(VehicleRecord& v) {

@@ -148,7 +148,8 @@ TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
   EXPECT_EQ(session.guardCounters().lane_changes_cooled_down, before + 1);
 
   // 5. A busy zone: its traffic slowed to a crawl (the test slows every vehicle in zone 0),
-  // a through CAV's change for speed gain is not carried out there, an exiting one's is.
+  // its CAVs drive themselves, a through CAV's change for speed gain is not carried out there,
+  // an exiting one's is.
   for (int i = 0; i < 60; ++i) {
     for (const VehicleRecord& v : session.vehicles())
       if (v.part == RoadPart::kMainline && v.x_m < 300.0) libsumo::Vehicle::slowDown(v.id, 2.0, 0.5);
@@ -163,6 +164,9 @@ TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
     if (std::isfinite(v.distance_to_exit_m) && slow_exiting.empty()) slow_exiting = v.id;
   }
   ASSERT_FALSE(slow_through.empty() || slow_exiting.empty()) << "no through and exiting CAVs in lanes 2-3 of zone 0";
+  // There advice slows nobody: the floor is the CAV's allowed speed itself.
+  EXPECT_NEAR(session.guardFloorMps(*session.find(slow_through)),
+              std::min(session.find(slow_through)->max_speed_mps, libsumo::Vehicle::getAllowedSpeed(slow_through)), 1e-9);
   const auto refused = session.guardCounters().lane_changes_busy_refused;
   if (session.find(slow_through)->lane < 3) {
     session.applyAdvisory(slow_through, LANE_LEFT, 0.0);

@@ -88,6 +88,9 @@ struct SessionOptions {
   double guard_busy_speed_share = 0.0;
   double guard_busy_leave_share = 0.0;
   double guard_busy_window_s = 30.0;
+  /// The floor's share in a busy zone (1 = advice slows nobody there: its CAVs drive
+  /// themselves; guard_floor_speed_share elsewhere).
+  double guard_busy_floor_speed_share = 1.0;
   /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
   /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
   /// lane-change model makes its own strategic, cooperative and speed-gain changes
