@@ -50,7 +50,8 @@ if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameter
 why=""
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas paper_printed:=true out_dir:=/tmp/unused 2>&1)"
 for expected in 'own_car_following: false' 'own_merge: false' 'max_advised_accel_mps2: 0.0' \
-                'lane_change_max_accel_mps2: 0.0' 'cav_lane_change_mode: 256' 'guard_floor_speed_share: 0.0'; do
+                'lane_change_max_accel_mps2: 0.0' 'cav_lane_change_mode: 256' 'guard_floor_speed_share: 0.0' \
+                'guard_busy_speed_share: 0.0'; do
   grep -q "^/palcas_sumo_bridge/$expected\$" <<<"$params" || why="$why paper_printed lacks '$expected';"
 done
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused 2>&1)"

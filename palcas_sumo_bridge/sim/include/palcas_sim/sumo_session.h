@@ -85,8 +85,8 @@ struct SessionOptions {
   /// that share is back above guard_busy_leave_share. In a busy zone an advised change that
   /// does not serve the CAV's route is not carried out (the CAV keeps its lane, as under
   /// KEEP): weaving for speed gain costs a busy road more than it gains. 0 = off.
-  double guard_busy_speed_share = 0.0;
-  double guard_busy_leave_share = 0.0;
+  double guard_busy_speed_share = 0.8;
+  double guard_busy_leave_share = 0.88;
   double guard_busy_window_s = 30.0;
   /// The floor's share in a busy zone (1 = advice slows nobody there: its CAVs drive
   /// themselves; guard_floor_speed_share elsewhere).
