@@ -28,6 +28,9 @@ MARGIN=15          # DSR points above keep a learnt policy must reach
 SPEED_SHARE=0.9    # of keep's average speed (all vehicles) it must keep
 TRAIN_SEED=1       # episodes use seeds 1..16 (a second attempt: 17..32)
 EVAL_SEED=101      # never used in training
+# The advice guard's busy zones off: they would filter even a random policy's advice into
+# DSR on this road (config/training/learning_only.yaml says why).
+BRIDGE="$ROOT/config/training/learning_only.yaml"
 JAM_SEEDS="101 102"     # held-out seeds of the jam check (training: 1..32)
 JAM_DEMANDS="1000 1600" # veh/h/lane: the tiny road's own (config/scenarios/tiny) and a busier one
 JAM_SHARE=0.5           # of keep's speed on the same traffic: below it, the policy jammed the road
@@ -46,10 +49,10 @@ outcome() {
 train_and_compare() {
   local name="$1" learning="$2"
   "$ROOT/palcas" train --scenario tiny --episodes 16 --duration 300 --seed "${3:-$TRAIN_SEED}" \
-    --learning "$learning" --rsu-params "$ROOT/config/training/short_rsu.yaml" \
+    --learning "$learning" --rsu-params "$ROOT/config/training/short_rsu.yaml" --bridge-params "$BRIDGE" \
     --out "$WORK/$name/train" >"$WORK/$name.train.log" 2>&1 || return 1
   "$ROOT/palcas" run --policy "$WORK/$name/train" --scenario tiny --duration 600 --seed "$EVAL_SEED" \
-    --out "$WORK/$name/eval" >"$WORK/$name.eval.log" 2>&1 || return 1
+    --bridge-params "$BRIDGE" --out "$WORK/$name/eval" >"$WORK/$name.eval.log" 2>&1 || return 1
   echo "$(outcome "$WORK/$name/eval/palcas/metrics.json") $(outcome "$WORK/$name/eval/keep/metrics.json")"
 }
 
@@ -109,9 +112,9 @@ no_jams() {
         dir="$main_eval"
       else
         "$ROOT/palcas" run --policy "$policy" --no-compare --scenario tiny --duration "$JAM_DURATION" --seed "$seed" \
-          --demand "$demand" --out "$dir" >"$WORK/jam-s$seed-d$demand.log" 2>&1 &&
+          --demand "$demand" --bridge-params "$BRIDGE" --out "$dir" >"$WORK/jam-s$seed-d$demand.log" 2>&1 &&
         "$ROOT/palcas" run --arm keep --no-compare --scenario tiny --duration "$JAM_DURATION" --seed "$seed" \
-          --demand "$demand" --out "$dir" >>"$WORK/jam-s$seed-d$demand.log" 2>&1 || { verdict=2; echo "learning jam check seed $seed demand $demand: the run failed ($WORK/jam-s$seed-d$demand.log)"; continue; }
+          --demand "$demand" --bridge-params "$BRIDGE" --out "$dir" >>"$WORK/jam-s$seed-d$demand.log" 2>&1 || { verdict=2; echo "learning jam check seed $seed demand $demand: the run failed ($WORK/jam-s$seed-d$demand.log)"; continue; }
       fi
       local p k
       read -r _ p < <(outcome "$dir/palcas/metrics.json" 2>/dev/null || echo "nan nan")
