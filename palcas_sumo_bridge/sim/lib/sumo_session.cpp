@@ -293,7 +293,7 @@ void SumoSession::updateZones() {
   std::vector<int> count(n, 0);
   for (const VehicleRecord& v : vehicles_) {
     if (v.part != RoadPart::kMainline || v.lane < 1 || v.max_speed_mps <= 0.0) continue;
-    const int k = static_cast<int>(v.x_m / options_.cluster_length_m);
+    const int k = zoneOf(v);
     if (k < 0 || k >= static_cast<int>(n)) continue;
     sum[k] += std::min(1.0, v.speed_mps / v.max_speed_mps);
     ++count[k];
@@ -308,6 +308,15 @@ void SumoSession::updateZones() {
     ++guard_.zone_steps;
     if (zone_busy_[k]) ++guard_.busy_zone_steps;
   }
+}
+
+int SumoSession::zoneOf(const VehicleRecord& v) const {
+  return static_cast<int>(v.x_m / options_.cluster_length_m);
+}
+
+void SumoSession::holdOwnDriving(VehicleRecord& v) const {
+  v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
+  v.command_value = v.speed_mps;
 }
 
 bool SumoSession::zoneBusy(int cluster) const {
@@ -525,7 +534,7 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
 double SumoSession::guardFloorMps(const VehicleRecord& v) const {
   // In a busy zone the floor is the allowed speed itself: advice slows nobody there, the
   // zone's CAVs drive themselves (only route-serving lane changes are still carried out).
-  const bool busy = zoneBusy(static_cast<int>(v.x_m / options_.cluster_length_m));
+  const bool busy = zoneBusy(zoneOf(v));
   const double share = busy ? options_.guard_busy_floor_speed_share : options_.guard_floor_speed_share;
   if (share <= 0.0) return 0.0;
   return share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
@@ -556,13 +565,12 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     const bool serves_route = (action == LANE_RIGHT && std::isfinite(v.distance_to_exit_m)) ||
                               (action == LANE_LEFT && v.on_accel_lane);
     const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
-    const bool busy = zoneBusy(static_cast<int>(v.x_m / options_.cluster_length_m));
+    const bool busy = zoneBusy(zoneOf(v));
     if (!serves_route && v.lane_change_target == 0 && (cooling || busy)) {
       // Weaving for no need of its own route: moments after its last change, or where the
       // road is busy.
       ++(busy ? guard_.lane_changes_busy_refused : guard_.lane_changes_cooled_down);
-      v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
-      v.command_value = v.speed_mps;
+      holdOwnDriving(v);
       return;
     }
     v.lane_change_target = target_lane;
@@ -572,8 +580,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     // wholly on an edge: continueLaneChange issues it there (within the same time budget).
     v.lane_change_edge.clear();
     if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
-    v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
-    v.command_value = v.speed_mps;
+    holdOwnDriving(v);
   } else if (action == ACCELERATE) {
     if (!std::isfinite(accel_mps2))
       throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
@@ -582,8 +589,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     v.command = HeldCommand::kAccelerate;
     v.command_value = limit > 0.0 ? std::clamp(accel_mps2, -limit, limit) : accel_mps2;
   } else if (action == KEEP) {
-    v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
-    v.command_value = v.speed_mps;
+    holdOwnDriving(v);
   } else {
     throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
   }
@@ -594,8 +600,7 @@ void SumoSession::endCommand(const std::string& id) {
   if (it == index_.end()) return;
   VehicleRecord& v = vehicles_[it->second];
   if (v.part == RoadPart::kOffRamp) return;
-  v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
-  v.command_value = v.speed_mps;
+  holdOwnDriving(v);
 }
 
 void SumoSession::applyHeldCommand(VehicleRecord& v) {

@@ -283,6 +283,10 @@ class SumoSession {
   std::vector<double> zone_speed_share_;
   std::vector<bool> zone_busy_;
   void updateZones();
+  /// RSU zone (cluster) a vehicle's x falls in; may be outside [0, clusters).
+  int zoneOf(const VehicleRecord& v) const;
+  /// No command of ours: its own car following (or, with own_car_following off, its speed).
+  void holdOwnDriving(VehicleRecord& v) const;
   std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
 };
 
