@@ -79,6 +79,12 @@ TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("penetration_rate"), std::string::npos) << e.what();
   }
+  try {
+    loadBridgeOptions(ros::NodeHandle("~bad_guard"));
+    FAIL() << "a guard floor of 1.5 x the allowed speed was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("guard_floor_speed_share"), std::string::npos) << e.what();
+  }
 }
 
 int main(int argc, char** argv) {
