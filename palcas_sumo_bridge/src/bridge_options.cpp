@@ -120,6 +120,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.guard_busy_window_s = p.number("guard_busy_window_s", o.session.guard_busy_window_s, 0.1, 3600.0);
   o.session.guard_busy_floor_speed_share =
       p.number("guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share, 0.0, 1.0);
+  o.session.guard_busy_handback = p.get<bool>("guard_busy_handback", o.session.guard_busy_handback);
   o.session.assist_mode = p.get<bool>("assist_mode", o.session.assist_mode);
   o.session.assist_lane_change_mode =
       p.integer("assist_lane_change_mode", o.session.assist_lane_change_mode, 0, 4095);

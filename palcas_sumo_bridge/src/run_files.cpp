@@ -127,6 +127,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"guard_busy_leave_share", o.session.guard_busy_leave_share},
           {"guard_busy_window_s", o.session.guard_busy_window_s},
           {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
+          {"guard_busy_handback", o.session.guard_busy_handback},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
@@ -248,7 +249,11 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"busy_speed_share", o.session.guard_busy_speed_share},
           {"lane_changes_busy_refused", g.lane_changes_busy_refused},
           {"busy_zone_pct", share(g.busy_zone_steps, g.zone_steps)},
-          {"busy_zone_s", o.scenario.step_length_s * g.busy_zone_steps}};
+          {"busy_zone_s", o.scenario.step_length_s * g.busy_zone_steps},
+          {"handback", o.session.guard_busy_handback},
+          {"handbacks", g.handbacks},
+          {"handback_cav_s", dt * g.handback_steps},
+          {"handback_advice_dropped", g.handback_advice_dropped}};
 }
 
 void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {

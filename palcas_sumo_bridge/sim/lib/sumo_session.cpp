@@ -397,11 +397,64 @@ void SumoSession::readVehicles() {
     v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
     updateDerived(v);
     if (v.lane_change_target != 0) continueLaneChange(v);
-    if (v.is_cav && options_.advisory_control && !options_.assist_mode) {
-      manageExit(v);
+    if (v.is_cav && options_.advisory_control) {
       if (v.merge_mode) updateMergeMode(v);
+      updateHandback(v);
+      if (v.handed_back) ++guard_.handback_steps;
+      if (!options_.assist_mode && !v.handed_back) manageExit(v);
     }
   }
+}
+
+void SumoSession::updateHandback(VehicleRecord& v) {
+  const bool busy_here = options_.guard_busy_handback && !v.merge_mode && road_->hasEdge(v.edge) &&
+                         (v.part == RoadPart::kMainline || v.part == RoadPart::kAccelLane) &&
+                         zoneBusy(zoneOf(v));
+  if (busy_here == v.handed_back) return;
+  if (options_.assist_mode) {  // it drives itself already: only its advice is dropped
+    v.handed_back = busy_here;
+    if (busy_here) ++guard_.handbacks;
+    return;
+  }
+  if (busy_here) {
+    // Its route to its off-ramp first: a CAV SUMO cannot route (e.g. mid-junction) waits a step.
+    if (v.exit_cluster >= 0 && !v.exit_committed && std::isfinite(v.distance_to_exit_m) && !routeToOwnExit(v))
+      return;
+    api::Vehicle::setLaneChangeMode(v.id, options_.assist_lane_change_mode);
+    v.command = HeldCommand::kNone;  // released in applyHeldCommand
+    v.handed_back = true;
+    ++guard_.handbacks;
+    return;
+  }
+  // Its zone is free again: lane changes (its exit included) are the RSUs' job once more.
+  api::Vehicle::setLaneChangeMode(v.id, options_.cav_lane_change_mode);
+  v.handed_back = false;
+  if (v.exit_cluster >= 0 && !end_edge_.empty() && std::isfinite(v.distance_to_exit_m)) {
+    try {
+      api::Vehicle::changeTarget(v.id, end_edge_);
+    } catch (const libsumo::TraCIException&) {
+      ++route_changes_failed_;  // keeps its route to its exit
+    }
+    v.exit_committed = false;  // manageExit re-commits it in lane 1 before its off-ramp
+  }
+}
+
+bool SumoSession::routeToOwnExit(VehicleRecord& v) {
+  std::vector<std::string> edges;
+  try {
+    edges = api::Route::getEdges(v.route_id);
+  } catch (const libsumo::TraCIException&) {
+    return false;
+  }
+  auto here = std::find(edges.begin(), edges.end(), v.edge);
+  if (here == edges.end()) return false;
+  try {
+    api::Vehicle::setRoute(v.id, std::vector<std::string>(here, edges.end()));
+  } catch (const libsumo::TraCIException&) {
+    ++route_changes_failed_;
+    return false;
+  }
+  return true;
 }
 
 void SumoSession::updateDerived(VehicleRecord& v) const {
@@ -555,12 +608,23 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
   auto it = index_.find(id);
   if (it == index_.end()) throw std::invalid_argument("applyAdvisory: unknown vehicle '" + id + "'");
   VehicleRecord& v = vehicles_[it->second];
-  if (action == LANE_LEFT || action == LANE_RIGHT) {
-    const int target_lane = action == LANE_LEFT ? v.lane + 1 : v.lane - 1;
-    const bool on_junction = !road_->hasEdge(v.edge);
-    if (!on_junction && road_->sumoLaneIndex(v.edge, target_lane) < 0)
-      throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
-                                  "' has no lane " + std::to_string(target_lane));
+  const bool lane_change = action == LANE_LEFT || action == LANE_RIGHT;
+  const int target_lane = action == LANE_LEFT ? v.lane + 1 : v.lane - 1;
+  if (lane_change && road_->hasEdge(v.edge) && road_->sumoLaneIndex(v.edge, target_lane) < 0)
+    throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
+                                "' has no lane " + std::to_string(target_lane));
+  if (action == ACCELERATE && !std::isfinite(accel_mps2))
+    throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
+                                std::to_string(accel_mps2));
+  if (!lane_change && action != ACCELERATE && action != KEEP)
+    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
+  if (v.handed_back) {
+    // Its zone is busy: it drives itself, route and lane changes included (guard_busy_handback).
+    ++guard_.handback_advice_dropped;
+    v.command = HeldCommand::kNone;
+    return;
+  }
+  if (lane_change) {
     ++guard_.lane_changes_advised;
     const bool serves_route = (action == LANE_RIGHT && std::isfinite(v.distance_to_exit_m)) ||
                               (action == LANE_LEFT && v.on_accel_lane);
@@ -582,16 +646,11 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
     holdOwnDriving(v);
   } else if (action == ACCELERATE) {
-    if (!std::isfinite(accel_mps2))
-      throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
-                                  std::to_string(accel_mps2));
     const double limit = options_.max_advised_accel_mps2;
     v.command = HeldCommand::kAccelerate;
     v.command_value = limit > 0.0 ? std::clamp(accel_mps2, -limit, limit) : accel_mps2;
-  } else if (action == KEEP) {
+  } else {  // KEEP
     holdOwnDriving(v);
-  } else {
-    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
   }
 }
 

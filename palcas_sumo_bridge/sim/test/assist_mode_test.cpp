@@ -29,10 +29,13 @@ TEST(AssistMode, CavsChangeLanesByThemselvesAndTakeTheirExitsWithoutAdvice) {
       if (v.part == RoadPart::kOffRamp && v.exit_cluster >= 0) exited.insert(v.id);
   }
   // Mainline CAVs are inserted on a random lane; those with an exit must reach lane 1 on
-  // their own, so nearly every one that left the road did it by its off-ramp.
+  // their own, so most that left the road did it by its off-ramp (89-95 %; in advisory mode
+  // without advice 38 %). The share varies from process to process with the same seed:
+  // SUMO 1.15's sublane model orders some vehicles by address (under `setarch -R` it is
+  // the same every run).
   ASSERT_GT(left_road.size(), 30u);
   std::size_t by_exit = 0;
   for (const std::string& id : left_road) by_exit += exited.count(id);
-  EXPECT_GE(by_exit, 0.9 * left_road.size()) << by_exit << " of " << left_road.size()
+  EXPECT_GE(by_exit, 0.8 * left_road.size()) << by_exit << " of " << left_road.size()
                                               << " CAVs with an exit left by it";
 }

@@ -91,6 +91,14 @@ struct SessionOptions {
   /// The floor's share in a busy zone (1 = advice slows nobody there: its CAVs drive
   /// themselves; guard_floor_speed_share elsewhere).
   double guard_busy_floor_speed_share = 1.0;
+  /// The guard's hand-back in a busy zone (advisory mode): its CAVs get their own route-aware
+  /// driving back, as in assist mode: a route to their off-ramp and SUMO's own lane changes
+  /// (assist_lane_change_mode), and no advice is carried out for them, until their zone is
+  /// free again (then lane changes are the RSUs' again). Where the road is busy, the CAVs
+  /// then drive as SUMO's drivers would, which an advisory mode that serves the exits by
+  /// advice alone cannot match there. In assist mode it only drops their advice (they drive
+  /// themselves already). false: a busy zone only refuses weaving (guard_busy_speed_share).
+  bool guard_busy_handback = true;
   /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
   /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
   /// lane-change model makes its own strategic, cooperative and speed-gain changes
@@ -115,6 +123,9 @@ struct GuardCounters {
   std::uint64_t lane_changes_cooled_down = 0;   ///< ... not carried out (cooldown)
   std::uint64_t lane_changes_busy_refused = 0;  ///< ... not carried out (busy zone)
   std::uint64_t busy_zone_steps = 0;            ///< zone steps a zone was busy (all zones)
+  std::uint64_t handbacks = 0;                  ///< CAVs handed back to their own driving
+  std::uint64_t handback_steps = 0;             ///< CAV steps spent handed back
+  std::uint64_t handback_advice_dropped = 0;    ///< advisories not carried out (handed back)
   std::uint64_t zone_steps = 0;                 ///< zone steps in all (zones x steps)
 };
 
@@ -155,6 +166,7 @@ struct VehicleRecord {
   bool exit_committed = false; ///< SUMO target switched to its off-ramp
   bool speed_overridden = false; ///< a setSpeed of ours is in force (else SUMO's own model)
   bool merge_mode = false;       ///< strategic lane changes allowed (own_merge, accel lane)
+  bool handed_back = false;      ///< busy zone: its own route-aware driving, advice dropped
   /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
   /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
   /// differ (a merge edge), until the target lane is reached or the time is up.
@@ -260,6 +272,11 @@ class SumoSession {
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
   void updateMergeMode(VehicleRecord& v);
+  /// guard_busy_handback: hands a CAV in a busy zone back to its own route-aware driving,
+  /// and takes it back once its zone is free.
+  void updateHandback(VehicleRecord& v);
+  /// Sets a CAV's route to the rest of its own (to its off-ramp); false when it is not on it.
+  bool routeToOwnExit(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
 
   SessionOptions options_;
