@@ -17,10 +17,28 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// policy_dir's value for an evaluation of an untrained network, asked for on purpose.
+constexpr const char* RANDOM_POLICY = "random";
+
+/// An evaluation runs trained weights: refused before anything waits for the bridge.
+void requireEvalWeights(const RsuNodeOptions& o) {
+  if (o.controller.train || o.policy_dir == RANDOM_POLICY) return;
+  if (o.policy_dir.empty())
+    throw std::runtime_error(
+        "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR (a training's "
+        "checkpoints/ folder; system.launch's default 'shipped' is config/policies/<arm>/checkpoints; "
+        "./palcas train makes new ones), or policy_dir:=random to evaluate an untrained network on "
+        "purpose. Only mode train starts from random weights");
+  if (!fs::is_directory(o.policy_dir))
+    throw std::runtime_error("policy_dir '" + o.policy_dir + "' is not a folder (eval needs a training's "
+                             "checkpoints/ folder, e.g. config/policies/palcas/checkpoints)");
+}
+
 /// The node's options with what they leave to the bridge's road filled in from it (the
 /// bridge sets it before opening registration; an RSU may start first, so wait for it).
 RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
   RsuNodeOptions o = loadRsuNodeOptions(private_nh);
+  requireEvalWeights(o);
   if (!takesFromBridgeRoad(o)) return o;  // all set here: checked at registration
   const auto road = common::waitForBridgeRoad(nh, o.register_timeout_s);
   if (!road)
@@ -77,7 +95,10 @@ std::string RsuNode::checkpointDir() const {
 
 void RsuNode::loadInitialModel() {
   const RsuControllerOptions& c = options_.controller;
-  if (!c.train && !options_.policy_dir.empty()) {
+  if (!c.train && options_.policy_dir == RANDOM_POLICY)
+    ROS_WARN("%s: evaluating an UNTRAINED network (policy_dir:=%s): its advice is random", c.rsu_id.c_str(),
+             RANDOM_POLICY);
+  if (!c.train && options_.policy_dir != RANDOM_POLICY) {
     // A federated policy is the server's global model; an independent one is per RSU; an RSU
     // with no model of its own (a zone the training did not have) starts from the policy's
     // default model, which tools/ship_policy.py ships beside per-RSU models.

@@ -60,7 +60,7 @@ ROS_IP="$HERE_IP" roslaunch -p "$port" palcas_launch bridge.launch scenario:=tin
 bridge_pid=$!
 wait_for 60 logged "SUMO 1.15" || true
 ip netns exec "$NS" env ROS_IP="$THERE_IP" ROS_MASTER_URI="$ROS_MASTER_URI" ROS_LOG_DIR="$WORK/ros_log_rsu" \
-  PATH="$PATH" roslaunch palcas_launch rsu.launch index:=0 scenario:=tiny mode:=eval federation:=false \
+  PATH="$PATH" roslaunch palcas_launch rsu.launch index:=0 scenario:=tiny mode:=eval policy_dir:=random federation:=false \
   i2i:=false >"$WORK/rsu.log" 2>&1 &
 rsu_pid=$!
 

@@ -54,7 +54,7 @@ for expected in 'own_car_following: false' 'own_merge: false' 'max_advised_accel
                 'guard_busy_speed_share: 0.0'; do
   grep -q "^/palcas_sumo_bridge/$expected\$" <<<"$params" || why="$why paper_printed lacks '$expected';"
 done
-params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused 2>&1)"
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas policy_bridge_params:=none out_dir:=/tmp/unused 2>&1)"
 grep -q '^/palcas_sumo_bridge/lane_change_max_accel_mps2: 0.0$' <<<"$params" || why="$why the default is not config/bridge.yaml's 0.0;"
 grep -q '^/palcas_sumo_bridge/guard_floor_speed_share: 0.6$' <<<"$params" || why="$why the advice guard is not on by default (0.6);"
 printf 'lane_change_max_accel_mps2: 2.0\nlane_change_duration_s: 3.0\n' >/tmp/palcas_policy_bridge_$$.yaml
@@ -77,6 +77,29 @@ grep -q '^/palcas_sumo_bridge/scenario/mainline_flow_vphpl: 1000.0$' <<<"$params
 grep -q '^/palcas_sumo_bridge/scenario/onramp_flow_vphpl: 300.0$' <<<"$params" || why="$why without ramp_demand the bridge lacks tiny's 300;"
 names+=(demand_reaches_the_bridge); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   demand_reaches_the_bridge"; else echo "FAIL demand_reaches_the_bridge: $why"; fi
+
+# No arguments evaluates the shipped policy, under its own bridge.yaml; so does every learning
+# arm that ships one (the launch file's list of them agrees with config/policies/). An
+# evaluation with no weights is refused; training starts from random weights.
+why=""
+for arm in palcas palcas_assist centralized independent no_priority; do
+  rsu=rsu_0; [ "$arm" != centralized ] || rsu=central
+  params="$(roslaunch --dump-params palcas_launch system.launch arm:="$arm" out_dir:=/tmp/unused 2>&1)"
+  grep -q "^/$rsu/rsu/policy_dir: $ROOT/config/policies/$arm/checkpoints\$" <<<"$params" ||
+    why="$why $arm does not evaluate config/policies/$arm/checkpoints;"
+  expected=0.0; [ ! -f "$ROOT/config/policies/$arm/bridge.yaml" ] ||
+    expected="$(sed -n 's/^lane_change_max_accel_mps2: *//p' "$ROOT/config/policies/$arm/bridge.yaml")"
+  grep -q "^/palcas_sumo_bridge/lane_change_max_accel_mps2: ${expected}\$" <<<"$params" ||
+    why="$why $arm does not run under its shipped bridge.yaml (lane_change_max_accel_mps2 $expected);"
+done
+out="$(roslaunch --nodes palcas_launch system.launch policy_dir:=none out_dir:=/tmp/unused 2>&1)" &&
+  why="$why eval with policy_dir:=none was accepted;"
+[[ "$out" == *mode_eval_needs_trained_weights* ]] || why="$why the refusal does not say what eval needs: $out;"
+params="$(roslaunch --dump-params palcas_launch system.launch mode:=train out_dir:=/tmp/unused 2>&1)"
+grep -q "^/rsu_0/rsu/policy_dir: ''\$" <<<"$params" || why="$why training is handed a policy_dir;"
+grep -q '^/palcas_sumo_bridge/lane_change_max_accel_mps2: 0.0$' <<<"$params" || why="$why training runs under a shipped bridge.yaml;"
+names+=(default_runs_the_shipped_policy); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   default_runs_the_shipped_policy"; else echo "FAIL default_runs_the_shipped_policy: $why"; fi
 
 why=""
 out="$(roslaunch --nodes palcas_launch system.launch arm:=bogus out_dir:=/tmp/unused 2>&1)" && why="an unknown arm was accepted"

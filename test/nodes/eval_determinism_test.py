@@ -30,7 +30,7 @@ def run_eval(out):
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
     return subprocess.run(
         ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=palcas", "scenario:=tiny",
-         "mode:=eval", "duration:=90", "seed:=7", "record:=true", "out_dir:=" + out,
+         "mode:=eval", "policy_dir:=random", "duration:=90", "seed:=7", "record:=true", "out_dir:=" + out,
          "learning_params:=%s/launch/small_learning.yaml" % tests,
          "bridge_params:=%s/launch/closed_loop_bridge.yaml" % tests],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300, text=True)
