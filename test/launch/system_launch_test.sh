@@ -111,5 +111,11 @@ why=""
 doc="$(roslaunch --ros-args palcas_launch system.launch 2>&1)"
 grep -q undocumented <<<"$doc" && why="undocumented arguments: $(grep undocumented <<<"$doc" | tr '\n' ' ')"
 [ -n "$why" ] || ! grep -q 'Required Arguments' <<<"$doc" || why="arguments listed as required: $doc"
+# The building blocks too: every argument of every launch file says what it is.
+for f in "$ROOT"/launch/*.launch; do
+  [ "$(basename "$f")" != system.launch ] || continue
+  doc="$(roslaunch --ros-args "$f" 2>&1)"
+  ! grep -q undocumented <<<"$doc" || why="$why $(basename "$f"): undocumented $(grep undocumented <<<"$doc" | tr -s ' \n' ' ');"
+done
 names+=(every_argument_documented); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   every_argument_documented"; else echo "FAIL every_argument_documented: $why"; fi
