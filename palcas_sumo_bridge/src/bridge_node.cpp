@@ -14,6 +14,7 @@
 #include <cmath>
 #include <thread>
 
+#include "palcas_sumo_bridge/bridge_diagnostics.h"
 #include "palcas_sumo_bridge/msg_conversion.h"
 #include "palcas_sumo_bridge/run_files.h"
 #include "palcas_sumo_bridge/topics.h"
@@ -52,6 +53,7 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
                                   ros::TransportHints().tcpNoDelay());
   publishRoad();  // before registration opens: an RSU checks its zone when it registers
   register_srv_ = nh_.advertiseService(REGISTER_RSU_SERVICE, &BridgeNode::onRegister, this);
+  setUpDiagnostics();
   ROS_INFO("palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
            session_->sumoVersion().c_str(), sim::SumoSession::apiName(), sumocfg_path_.c_str(),
            100.0 * options_.scenario.penetration_rate, options_.scenario.seed, options_.scenario.duration_s, options_.expected_rsus.size());
@@ -298,6 +300,69 @@ void BridgeNode::applyAdvisories() {
   }
 }
 
+void BridgeNode::setUpDiagnostics() {
+  diagnostics_.setHardwareID("palcas_sumo_bridge");
+  diagnostics_.add("lockstep", this, &BridgeNode::diagnoseLockstep);
+  diagnostics_.add("simulation", this, &BridgeNode::diagnoseSimulation);
+  diagnostics_.add("advice guard", this, &BridgeNode::diagnoseGuard);
+}
+
+void BridgeNode::diagnoseLockstep(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  LockstepFacts f;
+  f.expected = options_.expected_rsus;
+  f.lost = lockstep_->lostRsus();
+  f.late_steps = lockstep_->lateSteps();
+  f.late_steps_new = f.late_steps >= late_steps_reported_ ? f.late_steps - late_steps_reported_ : f.late_steps;
+  late_steps_reported_ = f.late_steps;
+  f.late_by_rsu = late_by_rsu_;
+  f.decisions = decision_ms_.size();
+  constexpr std::size_t RECENT = 2000;  // decisions: about the last 10 simulated minutes of 3 RSUs
+  f.decision_p50_ms = recentPercentile(decision_ms_, RECENT, 50.0);
+  f.decision_p99_ms = recentPercentile(decision_ms_, RECENT, 99.0);
+  describeLockstep(f, s);
+}
+
+void BridgeNode::diagnoseSimulation(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const metrics::EpisodeMetrics m = measure_->metrics().snapshot();
+  SimulationFacts f;
+  f.episode = episode_ + 1;
+  f.episodes = options_.first_episode + options_.episodes;
+  f.sim_s = session_->timeS();
+  f.duration_s = options_.scenario.duration_s;
+  const double wall_s = wallSeconds();
+  f.real_time_factor = wall_s > 0.0 ? f.sim_s / wall_s : 0.0;
+  f.on_road = m.vehicles_on_road;
+  f.speed_mps = m.efficiency_all_mps;
+  f.cr_pct = m.collision_rate_pct;
+  f.dsr_pct = m.dsr_pct;
+  f.msr_pct = m.msr_pct;
+  f.collisions = m.collisions;
+  f.teleports = m.teleports;
+  f.vanished_vehicles = session_->vanishedVehicles();
+  f.route_changes_failed = session_->routeChangesFailed();
+  f.insertion_dropped = session_->insertionDropped();
+  describeSimulation(f, s);
+}
+
+void BridgeNode::diagnoseGuard(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const sim::SessionOptions& o = options_.session;
+  const sim::GuardCounters& g = session_->guardCounters();
+  GuardFacts f;
+  f.advisory_control = o.advisory_control;
+  f.busy_zones_on = o.guard_busy_speed_share > 0.0;
+  f.zones = static_cast<int>(session_->road().clusters().size());
+  for (int k = 0; k < f.zones; ++k)
+    if (session_->zoneBusy(k)) f.busy_zones.push_back(k);
+  for (const sim::VehicleRecord& v : session_->vehicles()) f.handed_back_now += v.handed_back ? 1 : 0;
+  f.handbacks = g.handbacks;
+  f.advice_dropped = g.handback_advice_dropped;
+  f.lane_changes_busy_refused = g.lane_changes_busy_refused;
+  f.accelerate_guarded_pct = g.accelerate_steps > 0
+      ? 100.0 * static_cast<double>(g.accelerate_floored_steps + g.accelerate_released_steps) / g.accelerate_steps
+      : 0.0;
+  describeGuard(f, s);
+}
+
 void BridgeNode::publishMetrics() {
   palcas_msgs::EpisodeMetrics msg = toMsg(measure_->metrics().snapshot(), wallSeconds());
   msg.header.stamp = ros::Time(session_->timeS());
@@ -347,6 +412,7 @@ void BridgeNode::runEpisode(int episode) {
     session_->step();
     const auto t1 = std::chrono::steady_clock::now();
     publishStep();
+    diagnostics_.update();  // at most once per ~diagnostic_period (1 s of simulated time)
     if (recorder_) recorder_->addStep(session_->stepCount(), session_->timeS(), session_->vehicles());
     const auto t2 = std::chrono::steady_clock::now();
     timer.add(session_->vehicles().size(), std::chrono::duration<double>(t1 - t0).count(),

@@ -4,6 +4,7 @@
 // loop iteration: publish the state of step k, wait (lockstep) for the RSUs' advisories
 // for step k, apply them, advance SUMO to step k+1, measure.
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <palcas_core/message_auth.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/RegisterRsu.h>
@@ -59,6 +60,11 @@ class BridgeNode {
   void reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
               const std::string& detail);
   double wallSeconds() const;
+  /// /diagnostics: the lockstep, the simulation and the advice guard (bridge_diagnostics.h).
+  void setUpDiagnostics();
+  void diagnoseLockstep(diagnostic_updater::DiagnosticStatusWrapper& s);
+  void diagnoseSimulation(diagnostic_updater::DiagnosticStatusWrapper& s);
+  void diagnoseGuard(diagnostic_updater::DiagnosticStatusWrapper& s);
 
   ros::NodeHandle nh_, private_nh_;
   BridgeOptions options_;
@@ -88,6 +94,8 @@ class BridgeNode {
   std::vector<float> decision_ms_;  ///< this episode's RSU decision latencies [ms]
   std::chrono::steady_clock::time_point wall_start_;
   double next_metrics_s_ = 0.0;
+  diagnostic_updater::Updater diagnostics_;
+  std::uint64_t late_steps_reported_ = 0;  ///< lockstep late steps at the last diagnostics report
 };
 
 }  // namespace palcas::bridge
