@@ -1,5 +1,6 @@
 #include "palcas_fedserver/fedserver_node.h"
 
+#include <diagnostic_msgs/DiagnosticStatus.h>
 #include <std_msgs/String.h>
 #include <std_msgs/UInt32.h>
 
@@ -31,6 +32,9 @@ FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   version.data = server_.globalVersion();
   version_pub_.publish(version);
   publishStatus();
+  round_opened_s_ = nowS();
+  diagnostics_.setHardwareID("palcas_fedserver");
+  diagnostics_.add("federation", this, &FedServerNode::diagnose);
   const FederationOptions& f = options_.federation;
   ROS_INFO("palcas fedserver: round %u, global version %u (%zu values, layout %s), %zu RSU(s) "
            "expected, quorum %zu, deadline %.1f s, liveness %.1f s, checkpoints %s",
@@ -125,7 +129,50 @@ bool FedServerNode::onFetch(palcas_msgs::FetchGlobalModel::Request& req,
   return true;
 }
 
-void FedServerNode::onTimer(const ros::TimerEvent&) { pollAndReport(); }
+void FedServerNode::onTimer(const ros::TimerEvent&) {
+  pollAndReport();
+  diagnostics_.update();
+}
+
+void FedServerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  FederationFacts f;
+  f.status = server_.status();
+  f.expected_rsus = options_.federation.expected_rsus.size();
+  f.open_round_age_s = nowS() - round_opened_s_;
+  std::uint64_t rejected = 0;
+  for (const auto& [reason, n] : f.status.rejected_by_reason) rejected += n;
+  f.rejected_new = rejected >= rejected_reported_ ? rejected - rejected_reported_ : rejected;
+  rejected_reported_ = rejected;
+  describeFederation(f, s);
+}
+
+void describeFederation(const FederationFacts& f, diagnostic_updater::DiagnosticStatusWrapper& s) {
+  using diagnostic_msgs::DiagnosticStatus;
+  const FederationStatus& st = f.status;
+  if (st.failed_aggregations > 0)
+    s.summaryf(DiagnosticStatus::ERROR, "%lu round(s) averaged to a non-finite model (global model kept)",
+               static_cast<unsigned long>(st.failed_aggregations));
+  else if (f.rejected_new > 0)
+    s.summaryf(DiagnosticStatus::WARN, "%lu submission(s) refused since the last report",
+               static_cast<unsigned long>(f.rejected_new));
+  else if (st.fetch_unknown_rsu > 0)
+    s.summaryf(DiagnosticStatus::WARN, "%lu fetch(es) from RSUs not expected",
+               static_cast<unsigned long>(st.fetch_unknown_rsu));
+  else
+    s.summaryf(DiagnosticStatus::OK, "round %u open %.0f s, %zu of %zu submitted; global version %u", st.round,
+               f.open_round_age_s, st.submitted.size(), f.expected_rsus, st.global_version);
+  s.add("round", st.round);
+  s.addf("open round age [s]", "%.1f", f.open_round_age_s);
+  std::string submitted;
+  for (const std::string& id : st.submitted) submitted += (submitted.empty() ? "" : ", ") + id;
+  s.add("submitted this round", submitted.empty() ? std::string("none") : submitted);
+  s.add("global version", st.global_version);
+  s.add("rounds closed", st.rounds_closed);
+  s.addf("last round [s]", "%.2f", st.last_round_s);
+  s.add("failed aggregations", st.failed_aggregations);
+  for (const auto& [reason, n] : st.rejected_by_reason) s.add("refused: " + reason, n);
+  s.add("fetches from unknown RSUs", st.fetch_unknown_rsu);
+}
 
 void FedServerNode::pollAndReport() {
   if (!server_.poll(nowS())) return;
@@ -151,6 +198,7 @@ void FedServerNode::pollAndReport() {
   version.data = server_.globalVersion();
   version_pub_.publish(version);
   publishStatus();
+  round_opened_s_ = nowS();
 }
 
 void FedServerNode::publishStatus() {

@@ -4,7 +4,9 @@
 - every CAV inside each cluster receives exactly one advisory per decision, from the RSU of
   its zone, and a CAV handed over between clusters is advised by the new RSU, not the old;
 - after one federation round every RSU holds weights identical to the sample-weighted
-  average that this test computes itself from what the RSUs submitted.
+  average that this test computes itself from what the RSUs submitted;
+- the bridge and the federation server report on /diagnostics (rqt_robot_monitor), at OK
+  on this healthy run.
 """
 import threading
 import time
@@ -13,6 +15,7 @@ import unittest
 import numpy as np
 import rospy
 import rostest
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from palcas_msgs.msg import AdvisoryArray, ModelWeights, VehicleEventArray, VehicleStateArray
 
 WALL_TIMEOUT_S = 240.0
@@ -30,9 +33,11 @@ class ClosedLoopTest(unittest.TestCase):
         cls.event_steps = {}  # vehicle id -> steps with an event
         cls.submitted = {r: [] for r in cls.rsus}
         cls.models = {r: [] for r in cls.rsus}
+        cls.diagnostics = {}  # status name -> last DiagnosticStatus
         rospy.Subscriber("/vehicle_states", VehicleStateArray, cls.on_states, queue_size=1000)
         rospy.Subscriber("/advisories", AdvisoryArray, cls.on_advisories, queue_size=1000)
         rospy.Subscriber("/vehicle_events", VehicleEventArray, cls.on_events, queue_size=1000)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, cls.on_diagnostics, queue_size=100)
         for r in cls.rsus:
             rospy.Subscriber("/%s/submitted_weights" % r, ModelWeights, cls.on_submitted, r, queue_size=10)
             rospy.Subscriber("/%s/model" % r, ModelWeights, cls.on_model, r, queue_size=10)
@@ -48,6 +53,12 @@ class ClosedLoopTest(unittest.TestCase):
         if msg.step % cls.period == 0:
             with cls.lock:
                 cls.advised[(msg.step, msg.rsu_id)] = [a.vehicle_id for a in msg.advisories]
+
+    @classmethod
+    def on_diagnostics(cls, msg):
+        with cls.lock:
+            for status in msg.status:
+                cls.diagnostics[status.name] = status
 
     @classmethod
     def on_events(cls, msg):
@@ -73,6 +84,19 @@ class ClosedLoopTest(unittest.TestCase):
                     return
             time.sleep(0.05)
         self.fail("timed out waiting for " + what)
+
+    def test_nodes_report_on_diagnostics(self):
+        expected = ["palcas_sumo_bridge: lockstep", "palcas_sumo_bridge: simulation",
+                    "palcas_sumo_bridge: advice guard", "fedserver/palcas_fedserver: federation"]
+        self.wait_until(lambda: all(name in self.diagnostics for name in expected),
+                        "/diagnostics from the bridge and the server (have %s)" % sorted(self.diagnostics))
+        with self.lock:
+            lockstep = self.diagnostics["palcas_sumo_bridge: lockstep"]
+            values = {kv.key: kv.value for kv in lockstep.values}
+            self.assertEqual(values.get("expected RSUs"), ", ".join(self.rsus))
+            self.assertEqual(values.get("lost RSUs"), "none")
+            federation = self.diagnostics["fedserver/palcas_fedserver: federation"]
+            self.assertEqual(federation.level, DiagnosticStatus.OK, federation.message)
 
     def zone_of(self, x):
         for k in range(len(self.zones) - 1):

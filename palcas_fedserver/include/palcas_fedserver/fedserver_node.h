@@ -3,6 +3,7 @@
 // take RSU submissions and hand out the global model; a ROS-time timer (sim time under
 // use_sim_time) closes rounds; each closed round is logged, published and checkpointed.
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <palcas_msgs/FetchGlobalModel.h>
 #include <palcas_msgs/SubmitWeights.h>
 #include <ros/ros.h>
@@ -38,6 +39,8 @@ class FedServerNode {
   void pollAndReport();
   void publishStatus();
   static double nowS() { return ros::Time::now().toSec(); }
+  /// /diagnostics "federation" (describeFederation).
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& s);
 
   ros::NodeHandle nh_, private_nh_;
   FedServerOptions options_;
@@ -46,6 +49,21 @@ class FedServerNode {
   ros::Publisher status_pub_, version_pub_;
   ros::ServiceServer submit_srv_, fetch_srv_;
   ros::Timer poll_timer_;
+  diagnostic_updater::Updater diagnostics_;
+  double round_opened_s_ = 0.0;          ///< ROS time the open round opened (or the node started)
+  std::uint64_t rejected_reported_ = 0;  ///< submissions refused, at the last diagnostics report
 };
+
+/// What the federation status says about its health.
+struct FederationFacts {
+  FederationStatus status;
+  std::size_t expected_rsus = 0;
+  double open_round_age_s = 0.0;
+  std::uint64_t rejected_new = 0;  ///< submissions refused since the last report
+};
+/// OK while rounds average to finite models and nobody sends refused submissions; WARN after
+/// a refused submission (malformed, forged, stale) since the last report or an unknown RSU's
+/// fetch; ERROR once an average was not finite (the global model was kept).
+void describeFederation(const FederationFacts& f, diagnostic_updater::DiagnosticStatusWrapper& s);
 
 }  // namespace palcas::fedserver
