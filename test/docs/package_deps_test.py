@@ -99,6 +99,19 @@ class PackageDepsTest(unittest.TestCase):
                             missing.add("%s (%s)" % (pkg, f.relative_to(ROOT)))
                 self.assertEqual(sorted(missing), [], "%s/package.xml lacks what it launches" % folder)
 
+    def test_palcas_core_exports_its_flags(self):
+        # A package built against palcas_core's headers elsewhere (an install space, another
+        # workspace) gets C++17 and -march from its CMake config, not only from the target.
+        extras = ROOT / "devel/share/palcas_core/cmake/palcas_core-extras.cmake"
+        if not extras.exists():
+            self.skipTest("not built: ./palcas build first")
+        text = extras.read_text()
+        self.assertIn("CMAKE_CXX_STANDARD 17", text)
+        self.assertIn("add_compile_options(${palcas_core_ABI_OPTIONS}", text)
+        cache = (ROOT / "build/CMakeCache.txt").read_text()
+        if "PALCAS_NATIVE_ARCH:BOOL=ON" in cache:
+            self.assertIn('palcas_core_ABI_OPTIONS "-march=native"', text)
+
 
 if __name__ == "__main__":
     run_as_junit(sys.modules[__name__], "package_deps")
