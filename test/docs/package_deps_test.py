@@ -6,11 +6,16 @@
 - every ROS package a C++ file of the package includes (`#include <pkg/...>`) is a build
   dependency;
 - every `pkg="..."` a launch file starts is a run dependency (<depend> or <exec_depend>) of
-  the package holding that launch file; test launch files' packages are test dependencies.
+  the package holding that launch file; test launch files' packages are test dependencies;
+- palcas_core's CMake extras export the flags it was built with;
+- a plain `catkin_make` at the repository root stops and names the command that works.
 """
+import os
 import pathlib
 import re
+import subprocess
 import sys
+import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
@@ -111,6 +116,20 @@ class PackageDepsTest(unittest.TestCase):
         cache = (ROOT / "build/CMakeCache.txt").read_text()
         if "PALCAS_NATIVE_ARCH:BOOL=ON" in cache:
             self.assertIn('palcas_core_ABI_OPTIONS "-march=native"', text)
+
+    def test_plain_catkin_make_at_the_root_says_what_to_run(self):
+        # catkin_make's default source space is ./src, which here is the palcas_core package:
+        # it must stop at configure time naming the command that builds the workspace.
+        files = subprocess.run(["git", "-C", str(ROOT), "ls-files", "src", "CMakeLists.txt", "palcas"],
+                               capture_output=True, text=True, check=True).stdout.split()
+        with tempfile.TemporaryDirectory() as clone:
+            for f in files:
+                (pathlib.Path(clone) / f).parent.mkdir(parents=True, exist_ok=True)
+                (pathlib.Path(clone) / f).write_bytes((ROOT / f).read_bytes())
+            env = dict(os.environ, PATH="/usr/bin:/bin", PWD=clone)
+            r = subprocess.run(["catkin_make"], cwd=clone, capture_output=True, text=True, timeout=300, env=env)
+        self.assertNotEqual(r.returncode, 0, "a plain catkin_make at the root built src/ alone")
+        self.assertIn("catkin_make --source . --build build", r.stdout + r.stderr)
 
 
 if __name__ == "__main__":
