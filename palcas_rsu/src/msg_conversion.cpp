@@ -23,6 +23,7 @@ RoadSnapshot toSnapshot(const palcas_msgs::VehicleStateArray& states) {
     v.accel_lane_pos_m = s.accel_lane_pos_m;
     v.accel_lane_length_m = s.accel_lane_length_m;
     v.max_speed_mps = s.max_speed_mps;
+    v.driving_itself = s.driving_itself;
     snapshot.vehicles.push_back(std::move(v));
   }
   return snapshot;

@@ -61,6 +61,10 @@ TEST(MsgConversion, VehicleRecordToStateKeepsEveryField) {
   EXPECT_EQ(s.route_kind, palcas_msgs::VehicleState::ROUTE_RAMP_EXIT);
   EXPECT_EQ(s.entry_cluster, 1);
   EXPECT_EQ(s.exit_cluster, 2);
+  EXPECT_FALSE(s.driving_itself);
+  palcas::sim::VehicleRecord busy = rampCav();
+  busy.handed_back = true;  // the guard handed it back: the RSUs must see it
+  EXPECT_TRUE(toMsg(busy).driving_itself);
 }
 
 TEST(MsgConversion, ObservationFollowsTheRoadPart) {

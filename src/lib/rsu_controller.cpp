@@ -120,8 +120,9 @@ RsuController::RsuController(const RsuControllerOptions& options)
 
 bool RsuController::isMember(const VehicleSnapshot& v) const {
   // Zone [x_start, x_end); ramp / off-ramp vehicles (lane 0, not on the acceleration lane)
-  // cannot take lane-change advisories, so they are not members.
-  return v.is_cav && v.x_m >= options_.x_start_m && v.x_m < options_.x_end_m &&
+  // cannot take lane-change advisories, so they are not members; nor is a CAV driving
+  // itself (the bridge's guard drops its advice while its zone is busy).
+  return v.is_cav && !v.driving_itself && v.x_m >= options_.x_start_m && v.x_m < options_.x_end_m &&
          (v.lane >= 1 || v.on_accel_lane);
 }
 

@@ -200,9 +200,11 @@ TEST(RsuController, MembersAreCavsInTheZoneOnMainlineOrAccelerationLane) {
   ramp.lateral_m = -5.0;
   VehicleSnapshot hdv = cav("hdv", 2, 1000.0);
   hdv.is_cav = false;
+  VehicleSnapshot handed_back = cav("handed_back", 2, 1200.0);  // its zone is busy: not advised
+  handed_back.driving_itself = true;
   const RoadSnapshot r = road({cav("start", 1, 800.0), cav("end", 3, 1599.9),
                                cav("past", 2, 1600.0), cav("before", 4, 799.9), merging, ramp,
-                               hdv});
+                               hdv, handed_back});
   const DecisionOutput out = c.decide(r, 1, 0.1, GLOBAL, NONE);
   ASSERT_EQ(out.advisories.size(), 3u);  // one per member, in snapshot order
   EXPECT_EQ(out.advisories[0].vehicle_id, "start");
@@ -212,6 +214,7 @@ TEST(RsuController, MembersAreCavsInTheZoneOnMainlineOrAccelerationLane) {
   EXPECT_EQ(c.pendingCount(), 3u);
   EXPECT_FALSE(c.isMember(hdv));
   EXPECT_FALSE(c.isMember(ramp));
+  EXPECT_FALSE(c.isMember(handed_back));
 }
 
 TEST(RsuController, DecidesForAllMembersInOneGreedyBatchInEvalMode) {

@@ -29,6 +29,9 @@ struct VehicleSnapshot {
   double accel_lane_pos_m = 0.0;     ///< position along that acceleration lane [m]
   double accel_lane_length_m = 0.0;  ///< length of that acceleration lane [m]
   double max_speed_mps = 33.528;     ///< the vehicle's own maximum speed [m/s]
+  /// A CAV handed back to its own driving by the bridge's guard (busy zone): it is not
+  /// advised, since its advice would be dropped; it stays a neighbour in others' states.
+  bool driving_itself = false;
 };
 
 /// All vehicles one RSU reasons about at one step, on a road of num_lanes mainline lanes.
