@@ -24,6 +24,9 @@ ROWS = [
     ("advisories", "Advisories applied", "{}"),
     ("advisories_rejected", "Advisories rejected", "{}"),
     ("late_rsu_steps", "Late RSU steps", "{}"),
+    ("guard.busy_zone_pct", "Guard: zone time busy (%)", "{:.1f}"),
+    ("guard.handback_cav_s", "Guard: CAV-s handed back", "{:.0f}"),
+    ("guard.accelerate_guarded_pct", "Guard: ACCELERATE guarded (%)", "{:.1f}"),
     ("decision_ms_p50", "Decision p50 (ms)", "{:.2f}"),
     ("decision_ms_p90", "Decision p90 (ms)", "{:.2f}"),
     ("decision_ms_p99", "Decision p99 (ms)", "{:.2f}"),
@@ -43,14 +46,24 @@ def fmt(value, pattern):
         return str(value)
 
 
+def lookup(metrics, key):
+    """metrics[key], where a dotted key reaches into a nested block (guard.handback_cav_s)."""
+    value = metrics
+    for part in key.split("."):
+        if not isinstance(value, dict) or part not in value:
+            return None
+        value = value[part]
+    return value
+
+
 def main(paths):
     runs = [(pathlib.Path(p).parent.name, json.loads(pathlib.Path(p).read_text())) for p in paths]
     # Rows no run has (e.g. decision latency of a SUMO-native run) are left out.
-    rows = [r for r in ROWS if any(r[0] in m for _, m in runs)]
+    rows = [r for r in ROWS if any(lookup(m, r[0]) is not None for _, m in runs)]
     width = max(14, *(len(n) for n, _ in runs))
     print(f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs))
     for key, label, pattern in rows:
-        print(f"{label:34s}" + "".join(f"{fmt(m.get(key), pattern):>{width + 2}s}" for _, m in runs))
+        print(f"{label:34s}" + "".join(f"{fmt(lookup(m, key), pattern):>{width + 2}s}" for _, m in runs))
 
 
 if __name__ == "__main__":
