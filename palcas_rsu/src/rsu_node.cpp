@@ -82,6 +82,8 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
                               ros::TransportHints().tcpNoDelay());
   if (options_.i2i)
     cluster_sub_ = nh_.subscribe(CLUSTER_STATES_TOPIC, 20, &RsuNode::onClusterState, this);
+  diagnostics_.setHardwareID(c.rsu_id);
+  diagnostics_.add("decisions", this, &RsuNode::diagnose);
   waitForPeers();
   registerWithBridge();
   ROS_INFO("%s: cluster %d [%.0f, %.0f) m, %s, decides every %d step(s), federation %s, I2I %s",
@@ -113,6 +115,7 @@ void RsuNode::loadInitialModel() {
                                ", " + candidates[1].string() + ", " + candidates[2].string());
     const fs::path file = *found;
     controller_->loadPolicy(file.string());
+    policy_file_ = file.string();
     ROS_INFO("%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
     return;
   }
@@ -293,9 +296,23 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   status.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
   status.federation_reachable = federation_ && federation_->reachable();
   status_pub_.publish(status);
+  last_status_ = status;
+  recent_decision_ms_.add(out.decision_ms);
+  diagnostics_.update();
   // Last: federation and checkpoints above saw the model as the decision used it.
   if (options_.learner_thread && c.train)
     learner_ = std::async(std::launch::async, [this] { controller_->learn(); });
+}
+
+void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
+  RsuHealthFacts f;
+  f.last = last_status_;
+  f.decided = decisions_ > 0;
+  f.policy = policy_file_;
+  f.i2i = options_.i2i && !options_.whole_road;
+  f.federation = options_.federation;
+  f.decision_p99_ms = recent_decision_ms_.percentile(99.0);
+  describeRsu(f, s);
 }
 
 void RsuNode::onFederationEvent(FederationEvent event, const std::string& message) {

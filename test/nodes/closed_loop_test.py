@@ -5,8 +5,8 @@
   its zone, and a CAV handed over between clusters is advised by the new RSU, not the old;
 - after one federation round every RSU holds weights identical to the sample-weighted
   average that this test computes itself from what the RSUs submitted;
-- the bridge and the federation server report on /diagnostics (rqt_robot_monitor), at OK
-  on this healthy run.
+- the bridge, every RSU and the federation server report on /diagnostics
+  (rqt_robot_monitor), lockstep and federation at OK on this healthy run.
 """
 import threading
 import time
@@ -87,7 +87,8 @@ class ClosedLoopTest(unittest.TestCase):
 
     def test_nodes_report_on_diagnostics(self):
         expected = ["palcas_sumo_bridge: lockstep", "palcas_sumo_bridge: simulation",
-                    "palcas_sumo_bridge: advice guard", "fedserver/palcas_fedserver: federation"]
+                    "palcas_sumo_bridge: advice guard", "fedserver/palcas_fedserver: federation"] + \
+                   ["%s/rsu: decisions" % r for r in self.rsus]
         self.wait_until(lambda: all(name in self.diagnostics for name in expected),
                         "/diagnostics from the bridge and the server (have %s)" % sorted(self.diagnostics))
         with self.lock:
@@ -97,6 +98,10 @@ class ClosedLoopTest(unittest.TestCase):
             self.assertEqual(values.get("lost RSUs"), "none")
             federation = self.diagnostics["fedserver/palcas_fedserver: federation"]
             self.assertEqual(federation.level, DiagnosticStatus.OK, federation.message)
+            for r in self.rsus:
+                rsu = {kv.key: kv.value for kv in self.diagnostics["%s/rsu: decisions" % r].values}
+                self.assertEqual(rsu.get("mode"), "train")
+                self.assertEqual(rsu.get("I2I"), "on")
 
     def zone_of(self, x):
         for k in range(len(self.zones) - 1):

@@ -5,6 +5,7 @@
 // publishes the advisories, its ClusterState (I2I) and its RsuStatus; in train mode it runs
 // the federation exchange without blocking the advisories.
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <palcas_core/controller_model.h>
 #include <palcas_core/federation_client.h>
 #include <palcas_core/learning_log.h>
@@ -12,6 +13,7 @@
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/VehicleEventArray.h>
+#include <palcas_msgs/RsuStatus.h>
 #include <palcas_msgs/VehicleStateArray.h>
 #include <ros/ros.h>
 
@@ -22,6 +24,7 @@
 
 #include "palcas_rsu/federation_transport.h"
 #include "palcas_rsu/peer_states.h"
+#include "palcas_rsu/rsu_diagnostics.h"
 #include "palcas_rsu/rsu_options.h"
 
 namespace palcas::rsu {
@@ -53,6 +56,8 @@ class RsuNode {
   /// Closes this episode's row of learning.csv (errors logged, not thrown).
   void endEpisodeLog();
   std::string checkpointDir() const;
+  /// /diagnostics "<rsu>: decisions" (rsu_diagnostics.h).
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& s);
 
   ros::NodeHandle nh_, private_nh_;
   RsuNodeOptions options_;
@@ -78,6 +83,10 @@ class RsuNode {
   /// This zone's density at the previous decision: the "own" global density (veh/km).
   double last_own_density_ = std::numeric_limits<double>::quiet_NaN();
   bool first_state_ = true;
+  diagnostic_updater::Updater diagnostics_;
+  palcas_msgs::RsuStatus last_status_;  ///< of the last decision, for the diagnostics
+  RecentTimes recent_decision_ms_{1000};
+  std::string policy_file_;             ///< the model evaluated ("" in training)
 };
 
 }  // namespace palcas::rsu
