@@ -53,7 +53,6 @@ class BridgeNode {
   void publishStep();
   void waitForAdvisories();
   void applyAdvisories();
-  void advance();
   void publishMetrics();
   void onAdvisories(const ros::MessageEvent<const palcas_msgs::AdvisoryArray>& event);
   bool onRegister(palcas_msgs::RegisterRsu::Request& req, palcas_msgs::RegisterRsu::Response& res);
