@@ -84,9 +84,11 @@ class PolicyReplayTest(unittest.TestCase):
 
     def test_the_recording_policy_agrees_on_every_decision(self):
         out_csv = self.tmp + "/same.csv"
-        r = replay(self.bag, "--policy", self.policies["A"], "--learning", SMALL_LEARNING, "--csv", out_csv)
+        # No --learning: the small network's parameters come from the bag (/rsu_params).
+        r = replay(self.bag, "--policy", self.policies["A"], "--csv", out_csv)
         print(r.stdout)
         self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertIn("RSU parameters: as recorded in the bag", r.stdout)
         compared, percent = agreement(r.stdout)
         self.assertGreater(compared, 50, r.stdout)
         self.assertEqual(percent, 100.0, r.stdout)
@@ -96,6 +98,7 @@ class PolicyReplayTest(unittest.TestCase):
 
     def test_another_policy_reports_where_it_differs(self):
         out_csv = self.tmp + "/other.csv"
+        # --learning on top of the recorded parameters (the same values here).
         r = replay(self.bag, "--policy", self.policies["B"], "--learning", SMALL_LEARNING, "--csv", out_csv)
         print(r.stdout)
         self.assertEqual(r.returncode, 0, r.stdout)
@@ -128,7 +131,7 @@ class PolicyReplayTest(unittest.TestCase):
         self.assertIn("lacks /vehicle_states, /advisories", r.stdout)
 
         empty = tempfile.mkdtemp(dir=self.tmp)
-        r = replay(self.bag, "--policy", empty, "--learning", SMALL_LEARNING)
+        r = replay(self.bag, "--policy", empty)
         self.assertEqual(r.returncode, 1, r.stdout)
         self.assertIn("holds no model for rsu_0", r.stdout)
 
