@@ -255,7 +255,8 @@ int run(const Args& args) {
     std::string names;
     for (const auto& t : missing) names += (names.empty() ? "" : ", ") + t;
     throw InputError("the bag '" + args.bag + "' lacks " + names +
-                     " (replay needs the recorded vehicle states and advisories: record with ./palcas run --record)");
+                     " (replay needs the recorded vehicle states and advisories: record with ./palcas run --record; "
+                     "a keep or sumo_native run has no RSU to replay)");
   }
   int lanes_in_states = 0;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC)))
@@ -371,9 +372,17 @@ int run(const Args& args) {
   std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.step < b.step; });
   std::size_t next_event = 0;
 
+  std::optional<std::uint64_t> previous_step;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC))) {
     const auto states = m.instantiate<palcas_msgs::VehicleStateArray>();
-    if (!states || states->step % static_cast<std::uint64_t>(period) != 0) continue;
+    if (!states) continue;
+    // Advisories and cluster states are matched by step and time: one episode per bag.
+    if (previous_step && states->step < *previous_step)
+      throw InputError("the bag holds more than one episode (" + std::string(STATES_TOPIC) + " go from step " +
+                       std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
+                       "): replay handles a bag of one episode (./palcas run records one per arm)");
+    previous_step = states->step;
+    if (states->step % static_cast<std::uint64_t>(period) != 0) continue;
     ++decision_steps;
     const double now_s = states->header.stamp.toSec();
     while (next_event < events.size() && events[next_event].step < states->step) {
