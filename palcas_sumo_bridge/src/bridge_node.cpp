@@ -5,6 +5,7 @@
 #include <palcas_core/advisory_validator.h>
 #include <palcas_msgs/AdvisoryRejection.h>
 #include <palcas_msgs/EpisodeMetrics.h>
+#include <palcas_msgs/RoadDescription.h>
 #include <palcas_msgs/VehicleEventArray.h>
 #include <rosgraph_msgs/Clock.h>
 #include <ros/callback_queue.h>
@@ -73,6 +74,15 @@ void BridgeNode::publishRoad() {
   }
   nh_.setParam(common::ROAD_ZONES_PARAM, zones);
   nh_.setParam(common::ROAD_LANES_PARAM, session_->road().numMainLanes());
+  // The same road on a latched topic: a bag of the run then carries it (replay_policy).
+  palcas_msgs::RoadDescription road;
+  road.header.stamp = ros::Time(session_->timeS());
+  road.header.frame_id = MAP_FRAME;
+  road.zone_boundaries_m = zones;
+  road.num_lanes = static_cast<std::uint8_t>(session_->road().numMainLanes());
+  road.step_length_s = session_->stepLengthS();
+  road.scenario_dir = options_.scenario.scenario_dir;
+  road_pub_.publish(road);
 }
 
 void BridgeNode::advertise() {
@@ -85,6 +95,7 @@ void BridgeNode::advertise() {
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>(CLOCK_TOPIC, 1000);
   markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>(MARKERS_TOPIC, 2, true);
   tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>(TF_TOPIC, 10);
+  road_pub_ = nh_.advertise<palcas_msgs::RoadDescription>(ROAD_DESCRIPTION_TOPIC, 1, true);
   markers_pub_.publish(markers_->roadMarkers(ros::Time(0)));
 }
 

@@ -95,6 +95,19 @@ check experiment_policy_wrong_road "trained on road paper"  experiment --out "$O
 check experiment_without_out   "--out"                       experiment --arms keep
 check experiment_demand_zero   "--demands: 0 is outside"     experiment --out "$OUT" --arms keep --demands 1000,0
 check experiment_demand_text   "--demands: 'many' is not valid" experiment --out "$OUT" --arms keep --demands many
+# replay: a missing bag or policy, a bad value, --rate without --rviz (the bag's content is
+# checked by replay_policy itself: test/launch/policy_replay.test).
+ANY_FILE="$ROOT/README.md"
+check replay_without_bag       "no bag given"                replay --policy "$ROOT/config/policies/palcas"
+check replay_bag_missing       "bag '/nonexistent.bag': no such file" replay /nonexistent.bag --policy "$ROOT/config/policies/palcas"
+check replay_without_policy    "--policy DIR is required"    replay "$ANY_FILE"
+check replay_policy_missing    "--policy '/nonexistent'"     replay "$ANY_FILE" --policy /nonexistent
+check replay_tolerance_text    "--accel-tolerance 'tight'"   replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --accel-tolerance tight
+check replay_learning_missing  "--learning '/nonexistent'"   replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --learning /nonexistent
+check replay_unknown_option    "replay: unknown option '--bogus'" replay "$ANY_FILE" --bogus
+check replay_rate_zero         "--rate '0'"                  replay "$ANY_FILE" --rviz --rate 0
+check replay_rate_without_rviz "--rate goes with --rviz"     replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --rate 2
+check replay_rviz_with_policy  "it takes only --rate"        replay "$ANY_FILE" --rviz --policy "$ROOT/config/policies/palcas"
 
 # --resume takes road, PR, seed and duration from the training record and refuses a flag
 # that contradicts it (a fake record: these checks stop before anything is built or run).

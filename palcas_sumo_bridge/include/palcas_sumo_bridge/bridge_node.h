@@ -78,7 +78,7 @@ class BridgeNode {
   int episode_ = 0;
 
   ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,
-      markers_pub_, tf_pub_;
+      markers_pub_, tf_pub_, road_pub_;
   ros::Subscriber advisories_sub_;
   ros::ServiceServer register_srv_;
 

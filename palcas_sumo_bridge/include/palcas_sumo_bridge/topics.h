@@ -11,6 +11,8 @@ constexpr char EPISODE_METRICS_TOPIC[] = "episode_metrics";    // palcas_msgs/Ep
 constexpr char ADVISORY_REJECTIONS_TOPIC[] = "advisory_rejections";  // palcas_msgs/AdvisoryRejection
 constexpr char ADVISORIES_TOPIC[] = "advisories";              // palcas_msgs/AdvisoryArray (in)
 constexpr char MARKERS_TOPIC[] = "markers";                    // visualization_msgs/MarkerArray
+// Latched: the road (zones, lane count) for bags and replays; the RSUs read the parameters.
+constexpr char ROAD_DESCRIPTION_TOPIC[] = "road_description";  // palcas_msgs/RoadDescription
 constexpr char REGISTER_RSU_SERVICE[] = "register_rsu";        // palcas_msgs/RegisterRsu
 constexpr char CLOCK_TOPIC[] = "/clock";                       // rosgraph_msgs/Clock
 constexpr char TF_TOPIC[] = "/tf";                             // tf2_msgs/TFMessage

@@ -1,0 +1,522 @@
+// replay_policy: the RSUs of a policy run OPEN LOOP on a recorded episode (a rosbag of
+// `./palcas run --record` / system.launch record:=true), their advisories compared with the
+// recorded ones. Every decision is made as RsuNode::decide makes it: the same snapshot
+// conversion, the same I2I bookkeeping (peers' cluster states stamped before the decision),
+// the same decision period and policy loading order, eval mode. Usage and output:
+// palcas_rsu/README.md, "replay_policy".
+//
+// The RSU parameters (config/rsu.yaml, reward.yaml, learning.yaml, departures.yaml and
+// overrides) are read from the parameter server under ~ exactly as the node reads them;
+// `./palcas replay` starts a private master and loads them.
+
+#include <palcas_core/model_blob.h>
+#include <palcas_core/state_layout.h>
+#include <palcas_msgs/AdvisoryArray.h>
+#include <palcas_msgs/ClusterState.h>
+#include <palcas_msgs/RoadDescription.h>
+#include <palcas_msgs/VehicleEventArray.h>
+#include <palcas_msgs/VehicleStateArray.h>
+#include <ros/master.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "palcas_rsu/msg_conversion.h"
+#include "palcas_rsu/peer_states.h"
+#include "palcas_rsu/rsu_options.h"
+
+namespace fs = std::filesystem;
+using palcas::rsu::RsuController;
+using palcas::rsu::RsuNodeOptions;
+
+namespace {
+
+constexpr char STATES_TOPIC[] = "/vehicle_states";
+constexpr char EVENTS_TOPIC[] = "/vehicle_events";
+constexpr char ADVISORIES_TOPIC[] = "/advisories";
+constexpr char CLUSTER_TOPIC[] = "/cluster_states";
+constexpr char ROAD_TOPIC[] = "/road_description";
+
+/// Two ACCELERATE advisories agree when their accelerations differ by at most this [m/s^2].
+/// Both are float64 end to end, so an identical decision agrees exactly; the tolerance only
+/// absorbs a policy file rewritten with rounding, and is far below anything a CAV would feel.
+constexpr double DEFAULT_ACCEL_TOLERANCE = 1e-3;
+
+/// Bad input (not a bag, missing topics, no model, a model that does not fit): exit 1.
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+/// A bad command line: exit 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Args {
+  std::string bag;
+  std::string policy;
+  std::string csv;
+  double accel_tolerance = DEFAULT_ACCEL_TOLERANCE;
+};
+
+const char* USAGE =
+    "usage: replay_policy BAG --policy DIR [--csv FILE] [--accel-tolerance MPS2]\n"
+    "  BAG      a bag recorded by ./palcas run --record (system.launch record:=true)\n"
+    "  DIR      a training's checkpoints/ folder, or a policy folder that contains checkpoints/\n"
+    "  FILE     every disagreement as CSV (default: BAG without .bag + .replay.csv)\n"
+    "  MPS2     ACCELERATE advisories agree within this [m/s^2] (default 0.001)\n"
+    "RSU parameters: from the parameter server under ~ (./palcas replay loads them).\n";
+
+Args parseArgs(const std::vector<std::string>& argv) {
+  Args a;
+  for (std::size_t i = 0; i < argv.size(); ++i) {
+    const std::string& s = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argv.size() || argv[i + 1].rfind("--", 0) == 0)
+        throw UsageError("option " + s + " needs a value");
+      return argv[++i];
+    };
+    if (s == "--policy") a.policy = value();
+    else if (s == "--csv") a.csv = value();
+    else if (s == "--accel-tolerance") {
+      const std::string v = value();
+      char* end = nullptr;
+      a.accel_tolerance = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end != '\0' || !(a.accel_tolerance >= 0.0) || !std::isfinite(a.accel_tolerance))
+        throw UsageError("--accel-tolerance '" + v + "': expected a number >= 0");
+    } else if (s == "-h" || s == "--help") {
+      std::cout << USAGE;
+      std::exit(0);
+    } else if (s.rfind("--", 0) == 0) {
+      throw UsageError("unknown option '" + s + "'");
+    } else if (a.bag.empty()) {
+      a.bag = s;
+    } else {
+      throw UsageError("one bag only; '" + s + "' is a second");
+    }
+  }
+  if (a.bag.empty()) throw UsageError("no bag given");
+  if (a.policy.empty()) throw UsageError("--policy DIR is required");
+  if (a.csv.empty()) {
+    fs::path p(a.bag);
+    a.csv = (p.parent_path() / (p.stem().string() + ".replay.csv")).string();
+  }
+  return a;
+}
+
+const char* actionName(int action) {
+  switch (action) {
+    case palcas_msgs::Advisory::LANE_LEFT: return "LANE_LEFT";
+    case palcas_msgs::Advisory::LANE_RIGHT: return "LANE_RIGHT";
+    case palcas_msgs::Advisory::ACCELERATE: return "ACCELERATE";
+    case palcas_msgs::Advisory::KEEP: return "KEEP";
+    default: return "UNKNOWN";
+  }
+}
+
+/// One advisory as recorded or replayed (action < 0: none for that vehicle).
+struct Advice {
+  int action = -1;
+  double accel_mps2 = 0.0;
+};
+
+std::string adviceText(const Advice& a) {
+  if (a.action < 0) return "none";
+  if (a.action != palcas_msgs::Advisory::ACCELERATE) return actionName(a.action);
+  char text[64];
+  std::snprintf(text, sizeof text, "ACCELERATE %+.4f", a.accel_mps2);
+  return text;
+}
+
+/// The road as the bag describes it.
+struct Road {
+  std::vector<double> zones_m;
+  int num_lanes = 0;
+  std::string source;
+};
+
+/// Counts of agreement for one group (an RSU, a recorded action).
+struct Tally {
+  std::uint64_t compared = 0, agreed = 0;
+  std::string percent() const {
+    if (compared == 0) return "n/a";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f %%", 100.0 * static_cast<double>(agreed) / static_cast<double>(compared));
+    return text;
+  }
+};
+
+/// The model file an RSU of this policy loads, in RsuNode::loadInitialModel's order.
+fs::path policyFileFor(const fs::path& checkpoints, const std::string& rsu_id) {
+  const fs::path candidates[] = {checkpoints / "fedserver" / "global_model.palcas",
+                                 checkpoints / rsu_id / "model.palcas", checkpoints / "default" / "model.palcas"};
+  for (const fs::path& f : candidates)
+    if (fs::exists(f)) return f;
+  throw InputError("policy folder '" + checkpoints.string() + "' holds no model for " + rsu_id + ": none of " +
+                   candidates[0].string() + ", " + candidates[1].string() + ", " + candidates[2].string());
+}
+
+/// DIR is a training's checkpoints/ folder or a policy folder containing checkpoints/.
+fs::path checkpointsOf(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw InputError("--policy '" + dir + "': no such folder");
+  if (fs::is_directory(fs::path(dir) / "checkpoints")) return fs::path(dir) / "checkpoints";
+  return fs::path(dir);
+}
+
+/// The state size a model file's networks take (the first Linear layer of the parameter
+/// network), or -1 when its layout does not say.
+long stateSizeOfLayout(const std::string& layout) {
+  const std::string key = "mu[Linear(";
+  const auto at = layout.find(key);
+  if (at == std::string::npos) return -1;
+  return std::strtol(layout.c_str() + at + key.size(), nullptr, 10);
+}
+
+bool hasTopic(rosbag::Bag& bag, const std::string& topic) {
+  rosbag::View view(bag, rosbag::TopicQuery(topic));
+  return view.size() > 0;
+}
+
+Road readRoad(rosbag::Bag& bag, int lanes_in_states) {
+  Road road;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(ROAD_TOPIC))) {
+    if (auto r = m.instantiate<palcas_msgs::RoadDescription>()) {
+      road.zones_m = r->zone_boundaries_m;
+      road.num_lanes = r->num_lanes;
+      road.source = ROAD_TOPIC;
+      break;
+    }
+  }
+  if (road.zones_m.empty()) {
+    // A bag recorded before the road was: its I2I messages name every zone that published.
+    std::map<int, std::pair<double, double>> zones;
+    for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(CLUSTER_TOPIC)))
+      if (auto c = m.instantiate<palcas_msgs::ClusterState>()) zones[c->cluster_index] = {c->x_start_m, c->x_end_m};
+    bool contiguous = !zones.empty() && zones.begin()->first == 0;
+    int expect = 0;
+    for (const auto& [k, span] : zones) {
+      if (k != expect++ || (!road.zones_m.empty() && std::abs(road.zones_m.back() - span.first) > 1e-6)) {
+        contiguous = false;
+        break;
+      }
+      if (road.zones_m.empty()) road.zones_m.push_back(span.first);
+      road.zones_m.push_back(span.second);
+    }
+    if (!contiguous)
+      throw InputError(std::string("the bag has no ") + ROAD_TOPIC + " (recorded since the bridge publishes it) and its " +
+                       CLUSTER_TOPIC + " do not give every zone: the RSUs' zones are unknown");
+    road.num_lanes = lanes_in_states;
+    road.source = std::string(CLUSTER_TOPIC) + " (no " + ROAD_TOPIC + " in the bag)";
+  }
+  if (road.num_lanes != lanes_in_states)
+    throw InputError("the bag's road has " + std::to_string(road.num_lanes) + " lanes but its " + STATES_TOPIC +
+                     " say " + std::to_string(lanes_in_states));
+  return road;
+}
+
+/// One replayed RSU: its controller and I2I bookkeeping, as RsuNode holds them.
+struct ReplayedRsu {
+  std::string id;
+  RsuNodeOptions options;
+  std::unique_ptr<RsuController> controller;
+  std::unique_ptr<palcas::rsu::PeerStates> peers;
+  palcas::rsu::VehicleOutcomes outcomes;
+  double last_own_density = std::numeric_limits<double>::quiet_NaN();
+  fs::path model;
+  Tally tally;
+};
+
+int run(const Args& args) {
+  if (!fs::is_regular_file(args.bag)) throw InputError("'" + args.bag + "': no such file");
+  rosbag::Bag bag;
+  try {
+    bag.open(args.bag, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    throw InputError("'" + args.bag + "' is not a bag (" + e.what() + ")");
+  }
+  std::vector<std::string> missing;
+  for (const char* t : {STATES_TOPIC, ADVISORIES_TOPIC})
+    if (!hasTopic(bag, t)) missing.push_back(t);
+  if (!missing.empty()) {
+    std::string names;
+    for (const auto& t : missing) names += (names.empty() ? "" : ", ") + t;
+    throw InputError("the bag '" + args.bag + "' lacks " + names +
+                     " (replay needs the recorded vehicle states and advisories: record with ./palcas run --record; "
+                     "a keep or sumo_native run has no RSU to replay)");
+  }
+  int lanes_in_states = 0;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC)))
+    if (auto s = m.instantiate<palcas_msgs::VehicleStateArray>()) {
+      lanes_in_states = s->num_lanes;
+      break;
+    }
+  const Road road = readRoad(bag, lanes_in_states);
+  const int state_size = static_cast<int>(palcas::StateLayout(road.num_lanes).size());
+
+  // What the recording RSUs said, and who they were.
+  std::map<std::pair<std::uint64_t, std::string>, std::vector<palcas_msgs::Advisory>> recorded;
+  std::set<std::string> rsu_ids;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(ADVISORIES_TOPIC)))
+    if (auto a = m.instantiate<palcas_msgs::AdvisoryArray>()) {
+      rsu_ids.insert(a->rsu_id);
+      recorded[{a->step, a->rsu_id}] = a->advisories;
+    }
+  // I2I: every cluster state in stamp order, fed to the RSUs up to each decision's time.
+  std::vector<palcas_msgs::ClusterState> cluster_states;
+  std::map<std::string, int> cluster_of;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(CLUSTER_TOPIC)))
+    if (auto c = m.instantiate<palcas_msgs::ClusterState>()) {
+      cluster_states.push_back(*c);
+      cluster_of[c->rsu_id] = c->cluster_index;
+    }
+  std::stable_sort(cluster_states.begin(), cluster_states.end(),
+                   [](const auto& a, const auto& b) { return a.header.stamp < b.header.stamp; });
+  // The RSUs shared cluster states only with I2I on (palcas, palcas_assist, no_priority).
+  const bool i2i = !cluster_states.empty();
+  if (rsu_ids.empty()) throw InputError("the bag's " + std::string(ADVISORIES_TOPIC) + " name no RSU");
+
+  // Options: the node's own loader on the parameters under ~, then this RSU's identity and
+  // the recorded road, as the node adopts the bridge's.
+  ros::NodeHandle private_nh("~");
+  const RsuNodeOptions base = palcas::rsu::loadRsuNodeOptions(private_nh);
+  const fs::path checkpoints = checkpointsOf(args.policy);
+  std::vector<ReplayedRsu> rsus;
+  for (const std::string& id : rsu_ids) {
+    ReplayedRsu r;
+    r.id = id;
+    r.options = base;
+    palcas::rsu::RsuControllerOptions& c = r.options.controller;
+    c.rsu_id = id;
+    c.train = false;
+    r.options.whole_road = id == "central";  // the centralized baseline's one agent
+    r.options.i2i = i2i && !r.options.whole_road;
+    if (auto it = cluster_of.find(id); it != cluster_of.end()) {
+      c.cluster_index = it->second;
+    } else if (id.rfind("rsu_", 0) == 0 && id.size() > 4 &&
+               id.find_first_not_of("0123456789", 4) == std::string::npos) {
+      c.cluster_index = std::stoi(id.substr(4));
+    } else if (!r.options.whole_road) {
+      throw InputError("RSU '" + id + "' in the bag: its cluster is unknown (not rsu_<k>, central, nor in " +
+                       CLUSTER_TOPIC + ")");
+    }
+    if (!r.options.zones_m.empty()) palcas::rsu::applyZones(r.options, "zones_m");
+    try {
+      palcas::rsu::adoptBridgeRoad(r.options, road.zones_m, road.num_lanes);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(id + " on the recorded road: " + e.what());
+    }
+    r.model = policyFileFor(checkpoints, id);
+    palcas::ModelBlob blob;
+    try {
+      blob = palcas::loadModelBlob(r.model.string());
+    } catch (const std::exception& e) {
+      throw InputError("'" + r.model.string() + "' is not a PALCAS model: " + e.what());
+    }
+    const long model_states = stateSizeOfLayout(blob.layout_id);
+    if (model_states >= 0 && model_states != state_size)
+      throw InputError("the model '" + r.model.string() + "' takes a state of " + std::to_string(model_states) +
+                       " features, but the recorded road has " + std::to_string(road.num_lanes) +
+                       " lanes: its state has 40 + " + std::to_string(road.num_lanes) + " = " +
+                       std::to_string(state_size) + " (a policy trained on another road)");
+    r.controller = std::make_unique<RsuController>(r.options.controller);
+    try {
+      r.controller->loadPolicy(r.model.string());
+    } catch (const std::exception& e) {
+      throw InputError("the model '" + r.model.string() + "' does not fit the RSU network these parameters " +
+                       "build (give the learning override the policy was trained with: --learning FILE): " + e.what());
+    }
+    r.peers = std::make_unique<palcas::rsu::PeerStates>(r.options.controller.cluster_index, r.options.i2i_stale_after_s);
+    rsus.push_back(std::move(r));
+  }
+  const int period = base.decision_period_steps;
+
+  std::ofstream csv(args.csv);
+  if (!csv) throw InputError("cannot write the CSV '" + args.csv + "'");
+  csv << "step,time_s,rsu,vehicle,recorded_action,recorded_accel_mps2,replayed_action,replayed_accel_mps2\n";
+
+  std::printf("replay: %s\n  road: %zu zone(s), %d lanes (state size %d) from %s; decision every %d steps; I2I %s\n",
+              args.bag.c_str(), road.zones_m.size() - 1, road.num_lanes, state_size, road.source.c_str(), period,
+              i2i ? "on" : "off");
+  for (const ReplayedRsu& r : rsus)
+    std::printf("  %s [%.0f, %.0f) m: %s\n", r.id.c_str(), r.options.controller.x_start_m,
+                r.options.controller.x_end_m, r.model.c_str());
+
+  std::map<int, Tally> by_action;  // key: recorded action, -1 = the recording advised nothing
+  Tally total;
+  std::uint64_t decisions_unrecorded = 0, decision_steps = 0, not_decided = 0;
+  std::set<std::pair<std::uint64_t, std::string>> answered;  // recorded (step, rsu) the replay reached
+  bool diverged = false;
+  std::string first_divergence;
+  std::size_t next_cluster_state = 0;
+
+  // Events by step, not by bag time: the recorder's queue may write a step's states after
+  // later steps' events. The live RSU decides on step k's states before step k's events
+  // (published after them), so a decision at step k sees the events of steps before k.
+  std::vector<palcas_msgs::VehicleEventArray> events;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(EVENTS_TOPIC)))
+    if (auto e = m.instantiate<palcas_msgs::VehicleEventArray>()) events.push_back(*e);
+  std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.step < b.step; });
+  std::size_t next_event = 0;
+
+  std::optional<std::uint64_t> previous_step;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC))) {
+    const auto states = m.instantiate<palcas_msgs::VehicleStateArray>();
+    if (!states) continue;
+    // Advisories and cluster states are matched by step and time: one episode per bag.
+    if (previous_step && states->step < *previous_step)
+      throw InputError("the bag holds more than one episode (" + std::string(STATES_TOPIC) + " go from step " +
+                       std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
+                       "): replay handles a bag of one episode (./palcas run records one per arm)");
+    previous_step = states->step;
+    if (states->step % static_cast<std::uint64_t>(period) != 0) continue;
+    ++decision_steps;
+    const double now_s = states->header.stamp.toSec();
+    while (next_event < events.size() && events[next_event].step < states->step) {
+      for (ReplayedRsu& r : rsus) palcas::rsu::addOutcomes(events[next_event], r.outcomes);
+      ++next_event;
+    }
+    // Peers' statistics up to (not including) this decision's time; PeerStates itself also
+    // ignores those of the same step, as the live RSU does.
+    while (next_cluster_state < cluster_states.size() &&
+           cluster_states[next_cluster_state].header.stamp.toSec() < now_s - 1e-9) {
+      const palcas_msgs::ClusterState& c = cluster_states[next_cluster_state++];
+      for (ReplayedRsu& r : rsus)
+        if (r.options.i2i && c.rsu_id != r.id) {
+          try {
+            r.peers->update(c.cluster_index, c.rsu_id, c.density_veh_per_km, c.header.stamp.toSec());
+          } catch (const std::invalid_argument&) {
+            // The live RSU ignored it too (and warned).
+          }
+        }
+    }
+    const palcas::RoadSnapshot snapshot = palcas::rsu::toSnapshot(*states);
+    for (ReplayedRsu& r : rsus) {
+      const double unknown = std::numeric_limits<double>::quiet_NaN();
+      const palcas::GlobalDensities global = r.options.i2i ? r.peers->global(r.last_own_density, now_s)
+                                                           : palcas::GlobalDensities{unknown, unknown, unknown};
+      std::map<std::string, Advice> replayed;
+      try {
+        const palcas::rsu::DecisionOutput d = r.controller->advise(snapshot, states->step, now_s, global, r.outcomes);
+        r.outcomes.clear();
+        r.last_own_density = d.cluster.density_veh_per_km;
+        for (const auto& a : d.advisories) {
+          const palcas_msgs::Advisory msg = palcas::rsu::toMsg(a, d.model_version);
+          replayed[a.vehicle_id] = Advice{msg.action, msg.accel_mps2};
+        }
+      } catch (const std::invalid_argument& e) {
+        ++not_decided;  // the live RSU answered empty too
+      }
+      const auto key = std::make_pair(states->step, r.id);
+      const auto rec = recorded.find(key);
+      if (rec == recorded.end()) {
+        decisions_unrecorded += replayed.size();
+        continue;
+      }
+      answered.insert(key);
+      std::map<std::string, Advice> said;
+      for (const auto& a : rec->second) said[a.vehicle_id] = Advice{a.action, a.accel_mps2};
+      std::set<std::string> vehicles;
+      for (const auto& [v, _] : said) vehicles.insert(v);
+      for (const auto& [v, _] : replayed) vehicles.insert(v);
+      for (const std::string& v : vehicles) {
+        const Advice was = said.count(v) ? said[v] : Advice{};
+        const Advice now = replayed.count(v) ? replayed[v] : Advice{};
+        const bool agree = was.action == now.action &&
+                           (was.action != palcas_msgs::Advisory::ACCELERATE ||
+                            std::abs(was.accel_mps2 - now.accel_mps2) <= args.accel_tolerance);
+        for (Tally* t : {&total, &r.tally, &by_action[was.action]}) {
+          ++t->compared;
+          if (agree) ++t->agreed;
+        }
+        if (agree) continue;
+        char row[512];
+        std::snprintf(row, sizeof row, "%lu,%.3f,%s,%s,%s,%.6f,%s,%.6f\n", static_cast<unsigned long>(states->step),
+                      now_s, r.id.c_str(), v.c_str(), was.action < 0 ? "none" : actionName(was.action),
+                      was.accel_mps2, now.action < 0 ? "none" : actionName(now.action), now.accel_mps2);
+        csv << row;
+        if (!diverged) {
+          diverged = true;
+          char text[512];
+          std::snprintf(text, sizeof text, "step %lu (t = %.1f s), %s, vehicle %s: recorded %s, replayed %s",
+                        static_cast<unsigned long>(states->step), now_s, r.id.c_str(), v.c_str(),
+                        adviceText(was).c_str(), adviceText(now).c_str());
+          first_divergence = text;
+        }
+      }
+    }
+  }
+  // Recorded decisions whose vehicle states the bag lost: nothing to replay them from.
+  std::uint64_t recorded_without_states = 0;
+  for (const auto& [key, advisories] : recorded)
+    if (!advisories.empty() && key.first % static_cast<std::uint64_t>(period) == 0 && !answered.count(key))
+      recorded_without_states += advisories.size();
+
+  std::printf("decisions compared: %lu, agreement: %s\n", static_cast<unsigned long>(total.compared),
+              total.percent().c_str());
+  for (const ReplayedRsu& r : rsus)
+    std::printf("  %s: %lu compared, agreement %s\n", r.id.c_str(), static_cast<unsigned long>(r.tally.compared),
+                r.tally.percent().c_str());
+  for (int action : {0, 1, 2, 3, -1}) {
+    const auto it = by_action.find(action);
+    if (it == by_action.end() && action < 0) continue;
+    const Tally t = it == by_action.end() ? Tally{} : it->second;
+    std::printf("  recorded %s: %lu compared, agreement %s\n", action < 0 ? "none" : actionName(action),
+                static_cast<unsigned long>(t.compared), t.percent().c_str());
+  }
+  std::printf("first divergence: %s\n", diverged ? first_divergence.c_str() : "none");
+  std::printf("disagreements: %lu -> %s\n", static_cast<unsigned long>(total.compared - total.agreed),
+              args.csv.c_str());
+  std::printf("decision steps in the bag: %lu; not compared: %lu replayed advisories without a recorded answer, "
+              "%lu recorded advisories without recorded states%s\n",
+              static_cast<unsigned long>(decision_steps), static_cast<unsigned long>(decisions_unrecorded),
+              static_cast<unsigned long>(recorded_without_states),
+              not_decided ? (", " + std::to_string(not_decided) + " decisions refused a malformed state").c_str() : "");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "replay_policy", ros::init_options::NoSigintHandler);
+  std::vector<std::string> rest;
+  ros::removeROSArgs(argc, argv, rest);
+  rest.erase(rest.begin());
+  Args args;
+  try {
+    args = parseArgs(rest);
+  } catch (const UsageError& e) {
+    std::cerr << "replay_policy: " << e.what() << "\n" << USAGE;
+    return 2;
+  }
+  if (!ros::master::check()) {
+    std::cerr << "replay_policy: no ROS master at " << ros::master::getURI()
+              << ": the RSU parameters are read from it (./palcas replay starts one and loads them)\n";
+    return 1;
+  }
+  try {
+    return run(args);
+  } catch (const InputError& e) {
+    std::cerr << "replay_policy: " << e.what() << "\n";
+    return 1;
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "replay_policy: bad RSU parameter: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "replay_policy: " << e.what() << "\n";
+    return 1;
+  }
+}

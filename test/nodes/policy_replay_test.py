@@ -1,0 +1,153 @@
+#!/usr/bin/python3
+"""Test: `./palcas replay BAG --policy DIR` (palcas_rsu's replay_policy).
+
+Two short trainings on the tiny road (seeds 7 and 8, small network) give two policies A and B
+as model files; an evaluation of A is recorded (60 s). Then:
+  - replaying the bag with A agrees on 100 % of the decisions (no CSV row),
+  - replaying it with B reports where it differs (agreement < 100 %, CSV rows, a first divergence),
+  - bad input is refused with a clear message: not a bag, a bag without the needed topics,
+    a folder without a model, a model of another road's state size, no --policy.
+Each launch runs on its own master port; the replays start their own.
+"""
+import csv
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import rosbag
+import rospkg
+import rostest
+from rosgraph_msgs.msg import Clock
+
+TESTS = rospkg.RosPack().get_path("palcas_tests")
+ROOT = os.path.dirname(TESTS)
+SMALL_LEARNING = TESTS + "/launch/small_learning.yaml"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def launch(out, *args):
+    port = free_port()
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
+    result = subprocess.run(
+        ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=palcas", "scenario:=tiny",
+         "out_dir:=" + out, "learning_params:=" + SMALL_LEARNING,
+         "bridge_params:=%s/launch/closed_loop_bridge.yaml" % TESTS] + list(args),
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300, text=True)
+    return result.stdout
+
+
+def replay(*args):
+    env = dict(os.environ, PALCAS_NO_BUILD="1")
+    return subprocess.run([ROOT + "/palcas", "replay"] + list(args), env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, timeout=120, text=True)
+
+
+def agreement(output):
+    m = re.search(r"decisions compared: (\d+), agreement: ([0-9.]+) %", output)
+    return (int(m.group(1)), float(m.group(2))) if m else (0, None)
+
+
+class PolicyReplayTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="palcas_replay_")
+        cls.policies = {}
+        for name, seed in (("A", 7), ("B", 8)):
+            out = "%s/train_%s" % (cls.tmp, name)
+            os.makedirs(out)
+            # A short training writes every RSU's model.palcas (and the server's global model
+            # once a round closed): a policy as files, from its seed's initial network.
+            log = launch(out, "mode:=train", "seed:=%d" % seed, "duration:=30", "checkpoint_dir:=" + out + "/checkpoints",
+                         "rsu_params:=%s/launch/small_rsu.yaml" % TESTS)
+            cls.policies[name] = out + "/checkpoints"
+            assert os.path.exists(out + "/checkpoints/rsu_0/model.palcas"), log[-3000:]
+        cls.eval_dir = cls.tmp + "/eval_A"
+        os.makedirs(cls.eval_dir)
+        log = launch(cls.eval_dir, "mode:=eval", "seed:=11", "duration:=60", "record:=true",
+                     "policy_dir:=" + cls.policies["A"])
+        cls.bag = cls.eval_dir + "/episode.bag"
+        assert os.path.exists(cls.bag), log[-3000:]
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_the_recording_policy_agrees_on_every_decision(self):
+        out_csv = self.tmp + "/same.csv"
+        # No --learning: the small network's parameters come from the bag (/rsu_params).
+        r = replay(self.bag, "--policy", self.policies["A"], "--csv", out_csv)
+        print(r.stdout)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertIn("RSU parameters: as recorded in the bag", r.stdout)
+        compared, percent = agreement(r.stdout)
+        self.assertGreater(compared, 50, r.stdout)
+        self.assertEqual(percent, 100.0, r.stdout)
+        self.assertIn("first divergence: none", r.stdout)
+        with open(out_csv) as f:
+            self.assertEqual(len(list(csv.reader(f))), 1, "disagreements listed for the same policy")
+
+    def test_another_policy_reports_where_it_differs(self):
+        out_csv = self.tmp + "/other.csv"
+        # --learning on top of the recorded parameters (the same values here).
+        r = replay(self.bag, "--policy", self.policies["B"], "--learning", SMALL_LEARNING, "--csv", out_csv)
+        print(r.stdout)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        compared, percent = agreement(r.stdout)
+        self.assertGreater(compared, 50, r.stdout)
+        self.assertLess(percent, 100.0, r.stdout)
+        self.assertRegex(r.stdout, r"first divergence: step \d+ \(t = [0-9.]+ s\), rsu_\d, vehicle \S+: recorded ")
+        with open(out_csv) as f:
+            rows = list(csv.DictReader(f))
+        self.assertGreater(len(rows), 0)
+        wrong = int(re.search(r"disagreements: (\d+)", r.stdout).group(1))
+        self.assertEqual(len(rows), wrong)
+        self.assertTrue(all(row["recorded_action"] != row["replayed_action"] or
+                            abs(float(row["recorded_accel_mps2"]) - float(row["replayed_accel_mps2"])) > 1e-3
+                            for row in rows))
+
+    def test_bad_input_is_refused_naming_it(self):
+        text = self.tmp + "/not_a_bag.bag"
+        with open(text, "w") as f:
+            f.write("hello\n")
+        r = replay(text, "--policy", self.policies["A"])
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("is not a bag", r.stdout)
+
+        clock_only = self.tmp + "/clock_only.bag"
+        with rosbag.Bag(clock_only, "w") as bag:
+            bag.write("/clock", Clock())
+        r = replay(clock_only, "--policy", self.policies["A"])
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("lacks /vehicle_states, /advisories", r.stdout)
+
+        empty = tempfile.mkdtemp(dir=self.tmp)
+        r = replay(self.bag, "--policy", empty)
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("holds no model for rsu_0", r.stdout)
+
+        # The shipped palcas policy learnt the 5-lane paper road: 45 features, tiny has 3 lanes.
+        r = replay(self.bag, "--policy", ROOT + "/config/policies/palcas")
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("takes a state of 45 features", r.stdout)
+        self.assertIn("40 + 3 = 43", r.stdout)
+
+        r = replay(self.bag)
+        self.assertEqual(r.returncode, 2, r.stdout)
+        self.assertIn("--policy DIR is required", r.stdout)
+        r = replay(self.bag, "--policy", self.policies["A"], "--accel-tolerance", "x")
+        self.assertEqual(r.returncode, 2, r.stdout)
+        self.assertIn("--accel-tolerance 'x'", r.stdout)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("palcas_tests", "policy_replay_test", PolicyReplayTest, sys.argv)
