@@ -1,7 +1,7 @@
 #include "palcas_fedserver/fedserver_node.h"
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
-#include <std_msgs/String.h>
+#include <palcas_msgs/FederationStatus.h>
 #include <std_msgs/UInt32.h>
 
 #include <palcas_core/pdqn_agent.h>
@@ -23,7 +23,7 @@ FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       server_(options_.federation), auth_key_(common::loadMessageKey(options_.auth_key_file)) {
   if (options_.learning.state_size == 0) takeStateSizeFromTheRoad();
   initializeModel();
-  status_pub_ = nh_.advertise<std_msgs::String>(FEDERATION_STATUS_TOPIC, 1, true);
+  status_pub_ = nh_.advertise<palcas_msgs::FederationStatus>(FEDERATION_STATUS_TOPIC, 1, true);
   version_pub_ = nh_.advertise<std_msgs::UInt32>(GLOBAL_MODEL_VERSION_TOPIC, 1, true);
   submit_srv_ = nh_.advertiseService(SUBMIT_WEIGHTS_SERVICE, &FedServerNode::onSubmit, this);
   fetch_srv_ = nh_.advertiseService(FETCH_GLOBAL_MODEL_SERVICE, &FedServerNode::onFetch, this);
@@ -202,8 +202,23 @@ void FedServerNode::pollAndReport() {
 }
 
 void FedServerNode::publishStatus() {
-  std_msgs::String msg;
-  msg.data = federationStatusJson(server_.status());
+  const FederationStatus s = server_.status();
+  palcas_msgs::FederationStatus msg;
+  msg.header.stamp = ros::Time::now();
+  msg.round = s.round;
+  msg.global_version = s.global_version;
+  msg.submitted = s.submitted;
+  for (const auto& [reason, count] : s.rejected_by_reason) {
+    msg.rejection_reasons.push_back(reason);
+    msg.rejections.push_back(count);
+  }
+  msg.fetch_unknown_rsu = s.fetch_unknown_rsu;
+  msg.accepted_total = s.accepted_total;
+  msg.rounds_closed = s.rounds_closed;
+  msg.failed_aggregations = s.failed_aggregations;
+  msg.last_round_s = s.last_round_s;
+  msg.bytes_in_round = s.bytes_in_round;
+  msg.bytes_in_last_round = s.bytes_in_last_round;
   status_pub_.publish(msg);
 }
 

@@ -17,9 +17,17 @@ import unittest
 import numpy as np
 import rospy
 import rostest
-from palcas_msgs.msg import ModelWeights
+from palcas_msgs.msg import FederationStatus, ModelWeights
 from palcas_msgs.srv import FetchGlobalModel, SubmitWeights
-from std_msgs.msg import String, UInt32
+from std_msgs.msg import UInt32
+
+
+def status_fields(msg):
+    """The FederationStatus message as a dict (rejections by reason)."""
+    return {"round": msg.round, "version": msg.global_version, "submitted": list(msg.submitted),
+            "rejected_by_reason": dict(zip(msg.rejection_reasons, msg.rejections)),
+            "rounds_closed": msg.rounds_closed, "accepted_total": msg.accepted_total,
+            "bytes_in_last_round": msg.bytes_in_last_round}
 
 
 class FedServerRoundTest(unittest.TestCase):
@@ -32,7 +40,7 @@ class FedServerRoundTest(unittest.TestCase):
         self.version = None
         self.status = None
         rospy.Subscriber("global_model_version", UInt32, self.on_version)
-        rospy.Subscriber("federation_status", String, self.on_status)
+        rospy.Subscriber("federation_status", FederationStatus, self.on_status)
         rospy.wait_for_service("submit_weights", timeout=self.timeout_s)
         rospy.wait_for_service("fetch_global_model", timeout=self.timeout_s)
         self.submit_srv = rospy.ServiceProxy("submit_weights", SubmitWeights)
@@ -44,7 +52,7 @@ class FedServerRoundTest(unittest.TestCase):
 
     def on_status(self, msg):
         with self.lock:
-            self.status = json.loads(msg.data)
+            self.status = status_fields(msg)
 
     def wait_for(self, predicate, what):
         deadline = time.time() + self.timeout_s

@@ -14,7 +14,6 @@ the genuine one, and sign the global model it serves.
 import hashlib
 import hmac
 import io
-import json
 import os
 import threading
 import time
@@ -22,9 +21,9 @@ import unittest
 
 import rospy
 import rostest
-from palcas_msgs.msg import Advisory, AdvisoryArray, AdvisoryRejection, EpisodeMetrics, VehicleStateArray
+from palcas_msgs.msg import (Advisory, AdvisoryArray, AdvisoryRejection, EpisodeMetrics, FederationStatus,
+                             VehicleStateArray)
 from palcas_msgs.srv import FetchGlobalModel, RegisterRsu, SubmitWeights
-from std_msgs.msg import String
 
 WALL_TIMEOUT_S = 60.0
 RSU = "rsu_0"
@@ -70,7 +69,7 @@ class ForgedMessagesTest(unittest.TestCase):
         cls.pub = rospy.Publisher("/advisories", AdvisoryArray, queue_size=100)
         rospy.Subscriber("/advisory_rejections", AdvisoryRejection, cls.on_rejection, queue_size=1000)
         rospy.Subscriber("/episode_metrics", EpisodeMetrics, cls.on_metrics, queue_size=10)
-        rospy.Subscriber("/fedserver/federation_status", String, cls.on_fed_status, queue_size=10)
+        rospy.Subscriber("/fedserver/federation_status", FederationStatus, cls.on_fed_status, queue_size=10)
         rospy.Subscriber("/vehicle_states", VehicleStateArray, cls.on_states, queue_size=100,
                          tcp_nodelay=True)
         rospy.wait_for_service("/register_rsu", timeout=WALL_TIMEOUT_S)
@@ -116,7 +115,8 @@ class ForgedMessagesTest(unittest.TestCase):
     @classmethod
     def on_fed_status(cls, msg):
         with cls.lock:
-            cls.fed_status = json.loads(msg.data)
+            cls.fed_status = {"accepted_total": msg.accepted_total,
+                              "rejected_by_reason": dict(zip(msg.rejection_reasons, msg.rejections))}
 
     def wait_until(self, condition, what):
         end = time.monotonic() + WALL_TIMEOUT_S
