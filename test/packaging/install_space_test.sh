@@ -5,7 +5,7 @@
 # each writing its metrics.json. Reuses ./palcas build's build folder (only the install step
 # runs); about a minute.
 #
-#   test/install/install_space_test.sh [--xml FILE]
+#   test/packaging/install_space_test.sh [--xml FILE]
 set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 # shellcheck source=../junit.sh
