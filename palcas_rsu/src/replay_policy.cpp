@@ -128,6 +128,9 @@ const char* actionName(int action) {
   }
 }
 
+/// Two I2I densities agree when both are unknown (NaN) or equal.
+bool sameDensity(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
+
 /// One advisory as recorded or replayed (action < 0: none for that vehicle).
 struct Advice {
   int action = -1;
@@ -268,13 +271,22 @@ int run(const Args& args) {
   const int state_size = static_cast<int>(palcas::StateLayout(road.num_lanes).size());
 
   // What the recording RSUs said, and who they were.
-  std::map<std::pair<std::uint64_t, std::string>, std::vector<palcas_msgs::Advisory>> recorded;
+  std::map<std::pair<std::uint64_t, std::string>, palcas_msgs::AdvisoryArray> recorded;
   std::set<std::string> rsu_ids;
-  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(ADVISORIES_TOPIC)))
+  std::string other_definition;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(ADVISORIES_TOPIC))) {
     if (auto a = m.instantiate<palcas_msgs::AdvisoryArray>()) {
       rsu_ids.insert(a->rsu_id);
-      recorded[{a->step, a->rsu_id}] = a->advisories;
+      recorded[{a->step, a->rsu_id}] = *a;
+    } else if (other_definition.empty()) {
+      other_definition = m.getMD5Sum();
     }
+  }
+  if (rsu_ids.empty() && !other_definition.empty())
+    throw InputError("the bag's " + std::string(ADVISORIES_TOPIC) + " were recorded with another definition of " +
+                     "palcas_msgs/AdvisoryArray (md5 " + other_definition + ", this build's " +
+                     ros::message_traits::MD5Sum<palcas_msgs::AdvisoryArray>::value() +
+                     "): record it again with this version");
   // I2I: every cluster state in stamp order, fed to the RSUs up to each decision's time.
   std::vector<palcas_msgs::ClusterState> cluster_states;
   std::map<std::string, int> cluster_of;
@@ -362,6 +374,7 @@ int run(const Args& args) {
   bool diverged = false;
   std::string first_divergence;
   std::size_t next_cluster_state = 0;
+  std::uint64_t i2i_delivered_otherwise = 0;  // decisions whose live peer states differ from the bag's order
 
   // Events by step, not by bag time: the recorder's queue may write a step's states after
   // later steps' events. The live RSU decides on step k's states before step k's events
@@ -406,8 +419,20 @@ int run(const Args& args) {
     const palcas::RoadSnapshot snapshot = palcas::rsu::toSnapshot(*states);
     for (ReplayedRsu& r : rsus) {
       const double unknown = std::numeric_limits<double>::quiet_NaN();
-      const palcas::GlobalDensities global = r.options.i2i ? r.peers->global(r.last_own_density, now_s)
-                                                           : palcas::GlobalDensities{unknown, unknown, unknown};
+      const auto key = std::make_pair(states->step, r.id);
+      const auto rec = recorded.find(key);
+      palcas::GlobalDensities global = r.options.i2i ? r.peers->global(r.last_own_density, now_s)
+                                                     : palcas::GlobalDensities{unknown, unknown, unknown};
+      // Which peer states had reached the live RSU is not in the bag (topics between RSUs
+      // race, above all while they connect at start-up): decide on the ones it used.
+      if (r.options.i2i && rec != recorded.end()) {
+        const palcas_msgs::AdvisoryArray& said = rec->second;
+        if (!sameDensity(global.upstream, said.i2i_upstream_density_veh_per_km) ||
+            !sameDensity(global.downstream, said.i2i_downstream_density_veh_per_km))
+          ++i2i_delivered_otherwise;
+        global.upstream = said.i2i_upstream_density_veh_per_km;
+        global.downstream = said.i2i_downstream_density_veh_per_km;
+      }
       std::map<std::string, Advice> replayed;
       try {
         const palcas::rsu::DecisionOutput d = r.controller->advise(snapshot, states->step, now_s, global, r.outcomes);
@@ -420,15 +445,13 @@ int run(const Args& args) {
       } catch (const std::invalid_argument& e) {
         ++not_decided;  // the live RSU answered empty too
       }
-      const auto key = std::make_pair(states->step, r.id);
-      const auto rec = recorded.find(key);
       if (rec == recorded.end()) {
         decisions_unrecorded += replayed.size();
         continue;
       }
       answered.insert(key);
       std::map<std::string, Advice> said;
-      for (const auto& a : rec->second) said[a.vehicle_id] = Advice{a.action, a.accel_mps2};
+      for (const auto& a : rec->second.advisories) said[a.vehicle_id] = Advice{a.action, a.accel_mps2};
       std::set<std::string> vehicles;
       for (const auto& [v, _] : said) vehicles.insert(v);
       for (const auto& [v, _] : replayed) vehicles.insert(v);
@@ -461,9 +484,9 @@ int run(const Args& args) {
   }
   // Recorded decisions whose vehicle states the bag lost: nothing to replay them from.
   std::uint64_t recorded_without_states = 0;
-  for (const auto& [key, advisories] : recorded)
-    if (!advisories.empty() && key.first % static_cast<std::uint64_t>(period) == 0 && !answered.count(key))
-      recorded_without_states += advisories.size();
+  for (const auto& [key, array] : recorded)
+    if (!array.advisories.empty() && key.first % static_cast<std::uint64_t>(period) == 0 && !answered.count(key))
+      recorded_without_states += array.advisories.size();
 
   std::printf("decisions compared: %lu, agreement: %s\n", static_cast<unsigned long>(total.compared),
               total.percent().c_str());
@@ -485,6 +508,10 @@ int run(const Args& args) {
               static_cast<unsigned long>(decision_steps), static_cast<unsigned long>(decisions_unrecorded),
               static_cast<unsigned long>(recorded_without_states),
               not_decided ? (", " + std::to_string(not_decided) + " decisions refused a malformed state").c_str() : "");
+  if (i2i)
+    std::printf("I2I: %lu decision(s) where the live RSU had other peer states than the bag's order gives "
+                "(a message not yet received); replayed with the ones it used\n",
+                static_cast<unsigned long>(i2i_delivered_otherwise));
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include <palcas_msgs/RsuStatus.h>
 
 #include <filesystem>
+#include <limits>
 
 #include "palcas_rsu/msg_conversion.h"
 #include "palcas_rsu/topics.h"
@@ -222,6 +223,8 @@ void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::
   out.header = msg.header;
   out.step = msg.step;
   out.rsu_id = options_.controller.rsu_id;
+  out.i2i_upstream_density_veh_per_km = std::numeric_limits<double>::quiet_NaN();
+  out.i2i_downstream_density_veh_per_km = std::numeric_limits<double>::quiet_NaN();
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
   publishAdvisories(out);
 }
@@ -247,6 +250,8 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
     const double unknown = std::numeric_limits<double>::quiet_NaN();
     const GlobalDensities global = options_.i2i ? peers_.global(last_own_density_, now_s)
                                                 : GlobalDensities{unknown, unknown, unknown};
+    out.i2i_upstream_density_veh_per_km = global.upstream;
+    out.i2i_downstream_density_veh_per_km = global.downstream;
     decision = controller_->advise(snapshot, msg.step, now_s, global, outcomes_);
     outcomes_.clear();
     last_own_density_ = decision.cluster.density_veh_per_km;

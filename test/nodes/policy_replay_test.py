@@ -10,6 +10,7 @@ as model files; an evaluation of A is recorded (60 s). Then:
 Each launch runs on its own master port; the replays start their own.
 """
 import csv
+import math
 import os
 import re
 import shutil
@@ -95,6 +96,13 @@ class PolicyReplayTest(unittest.TestCase):
         self.assertIn("first divergence: none", r.stdout)
         with open(out_csv) as f:
             self.assertEqual(len(list(csv.reader(f))), 1, "disagreements listed for the same policy")
+        # The live RSUs' I2I inputs are in the bag (tiny: 2 zones, each the other's peer) and
+        # the replay says how often delivery differed from the bag's order.
+        self.assertRegex(r.stdout, r"I2I: \d+ decision\(s\) where the live RSU had other peer states")
+        with rosbag.Bag(self.bag) as bag:
+            used = [math.isfinite(m.i2i_upstream_density_veh_per_km) or math.isfinite(m.i2i_downstream_density_veh_per_km)
+                    for _, m, _ in bag.read_messages(topics=["/advisories"]) if m.advisories]
+        self.assertGreater(sum(used), len(used) // 2, "most decisions should have used a peer's density")
 
     def test_another_policy_reports_where_it_differs(self):
         out_csv = self.tmp + "/other.csv"
@@ -129,6 +137,17 @@ class PolicyReplayTest(unittest.TestCase):
         r = replay(clock_only, "--policy", self.policies["A"])
         self.assertEqual(r.returncode, 1, r.stdout)
         self.assertIn("lacks /vehicle_states, /advisories", r.stdout)
+
+        # Advisories recorded under another message definition (an older suite): named.
+        other = self.tmp + "/other_definition.bag"
+        with rosbag.Bag(self.bag) as src, rosbag.Bag(other, "w") as dst:
+            for topic, msg, t in src.read_messages(topics=["/vehicle_states", "/advisories", "/road_description"], raw=True):
+                if topic == "/advisories":
+                    msg = (msg[0], msg[1], "0" * 32, msg[3], msg[4])
+                dst.write(topic, msg, t, raw=True)
+        r = replay(other, "--policy", self.policies["A"])
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("recorded with another definition of palcas_msgs/AdvisoryArray", r.stdout)
 
         empty = tempfile.mkdtemp(dir=self.tmp)
         r = replay(self.bag, "--policy", empty)
