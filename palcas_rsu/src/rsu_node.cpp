@@ -183,6 +183,15 @@ void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) { ad
 
 void RsuNode::onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
   if (msg->rsu_id == options_.controller.rsu_id) return;
+  if (channel_) {
+    // I2I over the channel: lost, or held until the step it arrives at (decide() takes it).
+    ++i2i_received_;
+    const v2x::Delivery d =
+        channel_->transmit(v2x::MessageClass::CLUSTER_STATE, msg->rsu_id, options_.controller.rsu_id, msg->step);
+    if (d.lost) ++i2i_lost_;
+    else i2i_in_flight_.push(msg->step + d.delay_steps, *msg);
+    return;
+  }
   try {
     peers_.update(msg->cluster_index, msg->rsu_id, msg->density_veh_per_km, msg->header.stamp.toSec());
   } catch (const std::invalid_argument& e) {
@@ -198,15 +207,31 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     ros::shutdown();
     return;
   }
+  if (first_state_ && options_.v2x.enabled) {
+    const RsuControllerOptions& c = options_.controller;
+    // The centralized baseline is one agent over the whole road, not a radio: no range.
+    const double x_m = options_.whole_road ? 0.0 : 0.5 * (c.x_start_m + c.x_end_m);
+    v2x::ChannelParams p = options_.v2x;
+    if (options_.whole_road) p.rsu_range_m = std::numeric_limits<double>::infinity();
+    channel_ = std::make_unique<v2x::Channel>(p, msg->step_length_s);
+    uplink_ = std::make_unique<v2x::UplinkView>(*channel_, c.rsu_id, x_m);
+    ROS_INFO("%s: V2X channel on (seed %lu): states %.3f s + U(0, %.3f) s, lost %.1f %%; cluster states %.3f s + "
+             "U(0, %.3f) s, lost %.1f %%; range %.1f m from x = %.0f m; states forgotten after %.2f s",
+             c.rsu_id.c_str(), static_cast<unsigned long>(p.seed), p.vehicle_state.latency_s, p.vehicle_state.jitter_s,
+             100.0 * p.vehicle_state.loss_probability, p.cluster_state.latency_s, p.cluster_state.jitter_s,
+             100.0 * p.cluster_state.loss_probability, p.rsu_range_m, x_m, p.max_state_age_s);
+  }
   first_state_ = false;
   if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) {
     decide(*msg, received);
     return;
   }
   answerEmpty(*msg, received);
-  if (options_.controller.train && options_.controller.reward_over_period) {
+  const bool observe = options_.controller.train && options_.controller.reward_over_period;
+  if (observe || uplink_) {
     try {
-      controller_->observeStep(toSnapshot(*msg));  // never touches the agent: no join
+      const RoadSnapshot road = heard(*msg);  // the uplink hears every step
+      if (observe) controller_->observeStep(road);  // never touches the agent: no join
     } catch (const std::invalid_argument& e) {
       ROS_ERROR_THROTTLE(5.0, "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
                          static_cast<unsigned long>(msg->step), e.what());
@@ -244,7 +269,14 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   DecisionOutput decision;
   joinLearner();
   try {
-    const RoadSnapshot snapshot = toSnapshot(msg);
+    const RoadSnapshot snapshot = heard(msg);
+    for (const palcas_msgs::ClusterState& m : i2i_in_flight_.release(msg.step)) {
+      try {
+        peers_.update(m.cluster_index, m.rsu_id, m.density_veh_per_km, m.header.stamp.toSec());
+      } catch (const std::invalid_argument& e) {
+        ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
+      }
+    }
     // The own density is not known before deciding; the state builder takes the global
     // densities as given, so use the peers' view with the last own density.
     const double unknown = std::numeric_limits<double>::quiet_NaN();
@@ -318,6 +350,7 @@ void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
   f.federation = options_.federation;
   f.decision_p99_ms = recent_decision_ms_.percentile(99.0);
   describeRsu(f, s);
+  addChannelCounts(s);
 }
 
 void RsuNode::onFederationEvent(FederationEvent event, const std::string& message) {
@@ -350,6 +383,24 @@ void RsuNode::endEpisodeLog() {
   } catch (const std::runtime_error& e) {
     ROS_ERROR("%s: %s", options_.controller.rsu_id.c_str(), e.what());
   }
+}
+
+RoadSnapshot RsuNode::heard(const palcas_msgs::VehicleStateArray& msg) {
+  RoadSnapshot truth = toSnapshot(msg);
+  if (!uplink_) return truth;
+  return uplink_->receive(truth, msg.step);
+}
+
+void RsuNode::addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) const {
+  if (!uplink_) return;
+  const v2x::UplinkCounts& n = uplink_->counts();
+  s.add("V2X vehicle states sent", n.sent);
+  s.add("V2X vehicle states lost", n.lost);
+  s.add("V2X vehicle states out of range", n.out_of_range);
+  s.add("V2X vehicles forgotten (state too old)", n.forgotten);
+  s.add("V2X mean age of the states used [s]", n.used ? n.used_age_sum_s / static_cast<double>(n.used) : 0.0);
+  s.add("V2X cluster states lost", i2i_lost_);
+  s.add("V2X cluster states received", i2i_received_);
 }
 
 void RsuNode::shutdown() {

@@ -1,5 +1,7 @@
 #include "palcas_sumo_bridge/bridge_node.h"
 
+#include <algorithm>
+#include <limits>
 #include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
 #include <palcas_core/advisory_validator.h>
@@ -47,6 +49,7 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       rules_(measureRules(options_, session_->road())),
       measure_(std::make_unique<EpisodeMeasure>(rules_)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
+      channel_(options_.v2x, options_.scenario.step_length_s),
       holds_(static_cast<std::uint64_t>(options_.advisory_hold_steps)) {
   completeManifest(options_, session_->sumoVersion(), sim::SumoSession::apiName(), rules_);
   advertise();
@@ -260,21 +263,83 @@ void BridgeNode::reject(const std::string& rsu_id, const std::string& vehicle_id
                     detail.c_str());
 }
 
+double BridgeNode::rsuPositionM(const std::string& rsu_id) const {
+  const auto& clusters = session_->road().clusters();
+  if (rsu_id.rfind("rsu_", 0) != 0 || rsu_id.size() == 4 ||
+      rsu_id.find_first_not_of("0123456789", 4) != std::string::npos)
+    return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t k = std::stoul(rsu_id.substr(4));
+  if (k >= clusters.size()) return std::numeric_limits<double>::quiet_NaN();
+  return 0.5 * (clusters[k].x_start_m + clusters[k].x_end_m);
+}
+
+std::vector<BridgeNode::AdviceInFlight> BridgeNode::deliverAdvisories(std::uint64_t step) {
+  std::vector<AdviceInFlight> arrived;
+  for (const auto& array : pending_)
+    for (std::size_t i = 0; i < array->advisories.size(); ++i) {
+      ++downlink_counts_.sent;
+      if (!channel_.enabled()) {
+        ++downlink_counts_.delivered;
+        arrived.push_back({array, i});
+        continue;
+      }
+      const v2x::Delivery d =
+          channel_.transmit(v2x::MessageClass::ADVISORY, array->rsu_id, array->advisories[i].vehicle_id, array->step);
+      if (d.lost) ++downlink_counts_.lost;
+      else downlink_.push(array->step + d.delay_steps, {array, i});
+    }
+  if (!channel_.enabled()) return arrived;
+  const std::uint64_t max_age = channel_.stepsWithin(channel_.params().max_advice_age_s);
+  for (AdviceInFlight& in : downlink_.release(step)) {
+    const std::uint64_t age = step >= in.array->step ? step - in.array->step : 0;
+    if (age > max_age) {
+      ++downlink_counts_.too_old;
+      continue;
+    }
+    // Range when it arrives: a CAV that drove out of its RSU's reach does not hear it.
+    const sim::VehicleRecord* vehicle = session_->find(in.array->advisories[in.index].vehicle_id);
+    const double rsu_x = rsuPositionM(in.array->rsu_id);
+    if (vehicle && !std::isnan(rsu_x) && !channel_.inRange(rsu_x, vehicle->x_m)) {
+      ++downlink_counts_.out_of_range;
+      continue;
+    }
+    ++downlink_counts_.delivered;
+    if (age > 0) ++downlink_counts_.late;
+    downlink_counts_.delivered_age_sum_s += static_cast<double>(age) * channel_.stepLengthS();
+    arrived.push_back(std::move(in));
+  }
+  // Arrival order over ROS differs between runs; two RSUs may advise one CAV at once (stale
+  // states put it in both zones). The newest decision wins, then the lower RSU id: the same
+  // every run (the others are rejected as duplicates).
+  std::stable_sort(arrived.begin(), arrived.end(), [](const AdviceInFlight& a, const AdviceInFlight& b) {
+    if (a.array->step != b.array->step) return a.array->step > b.array->step;
+    if (a.array->rsu_id != b.array->rsu_id) return a.array->rsu_id < b.array->rsu_id;
+    return a.index < b.index;
+  });
+  return arrived;
+}
+
 void BridgeNode::applyAdvisories() {
   ros::getGlobalCallbackQueue()->callAvailable();
   metrics::AdvisoryLimits limits;
   limits.max_step_age = static_cast<std::uint64_t>(options_.max_advisory_age_steps);
+  // Advice the channel delayed answers an earlier step: as old as the channel allows.
+  if (channel_.enabled())
+    limits.max_step_age = std::max(limits.max_step_age, channel_.stepsWithin(channel_.params().max_advice_age_s));
   const std::uint64_t step = session_->stepCount();
   const int lanes = session_->road().numMainLanes();
   std::unordered_set<std::string> advised;
-  for (const auto& array : pending_) {
+  for (const auto& array : pending_)
     if (!array->advisories.empty()) {
       decision_ms_.push_back(array->decision_ms);
       if (recorder_)
         recorder_->addDecision(session_->timeS(), array->rsu_id, array->decision_ms,
                                array->advisories.size());
     }
-    for (const auto& a : array->advisories) {
+  {
+    for (const AdviceInFlight& in : deliverAdvisories(step)) {
+      const auto& array = in.array;
+      const palcas_msgs::Advisory& a = array->advisories[in.index];
       const metrics::AdvisoryRequest request = toRequest(a, array->step, array->rsu_id);
       const sim::VehicleRecord* vehicle = session_->find(a.vehicle_id);
       const metrics::AdvisoryVerdict verdict = metrics::validateAdvisory(
@@ -398,6 +463,8 @@ void BridgeNode::startEpisode(int episode) {
   measure_ = std::make_unique<EpisodeMeasure>(rules_);
   holds_.clear();
   pending_.clear();
+  downlink_.clear();
+  downlink_counts_ = v2x::DownlinkCounts{};
   late_by_rsu_.clear();
   decision_ms_.clear();
 }
@@ -459,6 +526,7 @@ void BridgeNode::runEpisode(int episode) {
   summary.route_changes_failed = session_->routeChangesFailed();
   summary.guard = session_->guardCounters();
   summary.insertion_dropped = session_->insertionDropped();
+  summary.downlink = downlink_counts_;
   writeMetricsJson(options_, summary, episode);
   ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
            options_.first_episode + options_.episodes, session_->timeS(), summary.wall_seconds, options_.out_dir.c_str());

@@ -1,6 +1,7 @@
 #include "palcas_sumo_bridge/bridge_options.h"
 
 #include <palcas_common/param_reader.h>
+#include <palcas_common/v2x_params.h>
 
 #include <cmath>
 #include <map>
@@ -131,6 +132,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.integer("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.integer("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
+  o.v2x = params::loadChannelParams(p);
   o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
   if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
   o.trajectory_period_steps =

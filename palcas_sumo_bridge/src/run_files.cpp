@@ -256,6 +256,27 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"handback_advice_dropped", g.handback_advice_dropped}};
 }
 
+// The advisories' way through the V2X channel (all zero but sent/delivered when it is off).
+json v2xJson(const BridgeOptions& o, const v2x::DownlinkCounts& d) {
+  auto link = [](const v2x::LinkModel& l) {
+    return json{{"latency_s", l.latency_s}, {"jitter_s", l.jitter_s}, {"loss_probability", l.loss_probability}};
+  };
+  const v2x::ChannelParams& c = o.v2x;
+  return {{"enabled", c.enabled},
+          {"vehicle_state", link(c.vehicle_state)},
+          {"advisory", link(c.advisory)},
+          {"cluster_state", link(c.cluster_state)},
+          {"rsu_range_m", std::isfinite(c.rsu_range_m) ? json(c.rsu_range_m) : json("inf")},
+          {"max_advice_age_s", c.max_advice_age_s},
+          {"advisories_sent", d.sent},
+          {"advisories_delivered", d.delivered},
+          {"advisories_applied_late", d.late},
+          {"advisories_lost", d.lost},
+          {"advisories_out_of_range", d.out_of_range},
+          {"advisories_too_old", d.too_old},
+          {"advice_mean_age_s", number(d.meanAgeS())}};
+}
+
 void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {
   const metrics::EpisodeMetrics& m = s.metrics;
   json timing = json::array();
@@ -295,6 +316,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"vanished_vehicles", s.vanished_vehicles},
               {"route_changes_failed", s.route_changes_failed},
               {"guard", guardJson(o, s.guard)},
+              {"v2x", v2xJson(o, s.downlink)},
               {"late_rsu_steps", m.late_rsu_steps},
               {"decision_ms_p50", percentile(s.decision_ms, 50)},
               {"decision_ms_p90", percentile(s.decision_ms, 90)},

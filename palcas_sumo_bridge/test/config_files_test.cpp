@@ -57,6 +57,25 @@ TEST(ConfigFiles, EveryKeyOfBridgeYamlEqualsTheCompiledInDefault) {
     ADD_FAILURE() << line;
 }
 
+TEST(ConfigFiles, TheV2xChannelIsOffUnlessAFileTurnsItOn) {
+  const auto off = loadBridgeOptions(ros::NodeHandle("~paper"));
+  EXPECT_FALSE(off.v2x.enabled);
+  const auto o = loadBridgeOptions(ros::NodeHandle("~impaired"));
+  EXPECT_TRUE(o.v2x.enabled);
+  EXPECT_DOUBLE_EQ(o.v2x.advisory.latency_s, 0.3);
+  EXPECT_DOUBLE_EQ(o.v2x.vehicle_state.loss_probability, 0.3);
+  EXPECT_DOUBLE_EQ(o.v2x.cluster_state.latency_s, 0.3);
+  EXPECT_DOUBLE_EQ(o.v2x.rsu_range_m, 509.4);  // MOSAIC SNS's default single-hop radius
+  EXPECT_DOUBLE_EQ(o.v2x.max_advice_age_s, 0.5);
+  EXPECT_EQ(o.v2x.seed, 104u);
+  try {
+    loadBridgeOptions(ros::NodeHandle("~bad_v2x"));
+    FAIL() << "a loss probability of 1 was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("v2x/advisory/loss_probability"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ConfigFiles, UnknownKeyIsNamed) {
   try {
     loadBridgeOptions(ros::NodeHandle("~typo"));

@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""Test: eval mode gives identical advisories for the same seed in two runs.
+"""Test: eval mode gives identical advisories for the same seed in two runs, with the V2X
+channel off and on (latency with jitter, loss and a range shorter than a zone: the channel's
+draws follow the seed alone).
 
 Runs `roslaunch palcas_launch system.launch arm:=palcas mode:=eval record:=true` twice on the tiny road
 (each on its own master port), reads /advisories from both bags and compares every decision:
@@ -24,7 +26,7 @@ def free_port():
         return s.getsockname()[1]
 
 
-def run_eval(out):
+def run_eval(out, *extra):
     port = free_port()
     tests = rospkg.RosPack().get_path("palcas_tests")
     env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_LOG_DIR=out + "/log")
@@ -32,7 +34,7 @@ def run_eval(out):
         ["roslaunch", "-p", str(port), "palcas_launch", "system.launch", "arm:=palcas", "scenario:=tiny",
          "mode:=eval", "policy_dir:=random", "duration:=90", "seed:=7", "record:=true", "out_dir:=" + out,
          "learning_params:=%s/launch/small_learning.yaml" % tests,
-         "bridge_params:=%s/launch/closed_loop_bridge.yaml" % tests],
+         "bridge_params:=%s/launch/closed_loop_bridge.yaml" % tests] + list(extra),
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=300, text=True)
 
 
@@ -48,11 +50,33 @@ def decisions(bag_path):
 
 class EvalDeterminismTest(unittest.TestCase):
     def test_same_seed_same_advisories(self):
+        self.same_twice()
+
+    def test_same_seed_same_advisories_through_the_v2x_channel(self):
+        tests = rospkg.RosPack().get_path("palcas_tests")
+        outs = self.same_twice("v2x_params:=%s/launch/v2x_impaired.yaml" % tests)
+        channel = [json.load(open(out + "/metrics.json"))["v2x"] for out in outs]
+        self.assertEqual(channel[0], channel[1], "the channel's counts differ between the runs")
+        c = channel[0]
+        self.assertTrue(c["enabled"])
+        # 20 % lost, every delivered one 2-3 steps late, some beyond the 120 m range.
+        self.assertGreater(c["advisories_sent"], 200, c)
+        self.assertAlmostEqual(c["advisories_lost"] / c["advisories_sent"], 0.2, delta=0.05)
+        self.assertEqual(c["advisories_applied_late"], c["advisories_delivered"], c)
+        self.assertGreaterEqual(c["advice_mean_age_s"], 0.2 - 1e-9)
+        self.assertLessEqual(c["advice_mean_age_s"], 0.3 + 1e-9)
+        self.assertGreater(c["advisories_out_of_range"], 0, c)
+        # Every advisory sent met one fate, but those still on their way when the run ended.
+        fates = c["advisories_lost"] + c["advisories_out_of_range"] + c["advisories_too_old"] + c["advisories_delivered"]
+        self.assertLessEqual(fates, c["advisories_sent"], c)
+        self.assertGreater(fates, 0.95 * c["advisories_sent"], c)
+
+    def same_twice(self, *extra):
         runs, outs = [], []
         for _ in range(2):
             out = tempfile.mkdtemp(prefix="palcas_eval_")
             outs.append(out)
-            result = run_eval(out)
+            result = run_eval(out, *extra)
             self.assertTrue(os.path.exists(out + "/episode.bag"), result.stdout[-3000:])
             runs.append(decisions(out + "/episode.bag"))
         a, b = runs
@@ -68,6 +92,7 @@ class EvalDeterminismTest(unittest.TestCase):
                            "too few decisions in both bags to compare (%d of %d)" % (len(common), counts[0]))
         differing = [k for k in common if a[k] != b[k]]
         self.assertFalse(differing[:5], "different advisories at (step, rsu) %s" % differing[:5])
+        return outs
 
 
 if __name__ == "__main__":

@@ -69,6 +69,17 @@ class RsuNode {
   void joinLearner();
   PeerStates peers_;
   VehicleOutcomes outcomes_;
+  // The V2X channel on this RSU's side (options_.v2x.enabled): built at the first state
+  // (it needs the step length); null = off, every message as it comes.
+  std::unique_ptr<v2x::Channel> channel_;
+  std::unique_ptr<v2x::UplinkView> uplink_;
+  v2x::DelayLine<palcas_msgs::ClusterState> i2i_in_flight_;
+  std::uint64_t i2i_lost_ = 0, i2i_received_ = 0;
+  /// The road as this RSU hears it at the state's step (the uplink; the state itself when
+  /// the channel is off). @throws std::invalid_argument for a malformed state.
+  RoadSnapshot heard(const palcas_msgs::VehicleStateArray& msg);
+  /// The channel's counts as /diagnostics key-values (nothing when it is off).
+  void addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) const;
 
   ros::Publisher advisories_pub_, cluster_pub_, status_pub_, submitted_pub_, model_pub_;
   ros::Subscriber states_sub_, events_sub_, cluster_sub_;

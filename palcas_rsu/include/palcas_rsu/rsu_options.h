@@ -4,6 +4,7 @@
 // ~state_scales/*), config/reward.yaml (~reward/*), config/learning.yaml (~learning/*).
 
 #include <palcas_core/rsu_controller.h>
+#include <palcas_core/v2x/v2x_channel.h>
 #include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
 
@@ -37,6 +38,9 @@ struct RsuNodeOptions {
   bool i2i = true;                   ///< false: no cluster-state exchange (global part unknown)
   double i2i_stale_after_s = 5.0;    ///< sim time after which a peer's state is stale [s]
   double register_timeout_s = 60.0;  ///< wall time to wait for the bridge's register service [s]
+  /// ~v2x/* (config/v2x.yaml): this RSU's side of the V2X channel, the vehicle states it
+  /// hears (uplink) and the peers' cluster states (I2I). Off by default.
+  v2x::ChannelParams v2x;
 };
 
 /// @throws std::invalid_argument naming the key for a bad, unknown or missing parameter.

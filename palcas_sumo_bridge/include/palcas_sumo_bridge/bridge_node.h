@@ -85,6 +85,20 @@ class BridgeNode {
   palcas_msgs::VehicleStateArray current_states_;
   /// Advisory arrays received for the open step, by RSU, in arrival order.
   std::vector<palcas_msgs::AdvisoryArray::ConstPtr> pending_;
+  /// One advisory on its way to its CAV (the V2X channel's downlink).
+  struct AdviceInFlight {
+    palcas_msgs::AdvisoryArray::ConstPtr array;
+    std::size_t index = 0;
+  };
+  v2x::Channel channel_;
+  v2x::DelayLine<AdviceInFlight> downlink_;
+  v2x::DownlinkCounts downlink_counts_;
+  /// The advisories that reach their CAVs this step: every one of pending_ with the channel
+  /// off; through latency, loss, range and max age with it on (counted in downlink_counts_).
+  std::vector<AdviceInFlight> deliverAdvisories(std::uint64_t step);
+  /// Where RSU `rsu_id` stands along the road (its zone's centre) [m]; NaN for one without
+  /// a zone (the centralized baseline): no range applies to it.
+  double rsuPositionM(const std::string& rsu_id) const;
   /// Who advised each CAV last and when: its command holds for advisory_hold_steps,
   /// unless that RSU is late, then its own driving takes over.
   sim::AdvisoryHolds holds_;

@@ -3,6 +3,7 @@
 // (loadBridgeOptions, the only caller of getParam). Defaults and meaning: README.md of
 // this package and config/bridge.yaml.
 
+#include <palcas_core/v2x/v2x_channel.h>
 #include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
 
@@ -34,6 +35,9 @@ struct BridgeOptions {
   int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
   int lost_after_missed_steps = 50;        ///< consecutive misses before an RSU is lost
   int max_advisory_age_steps = 0;          ///< 0 = an advisory must answer the current step
+  /// ~v2x/* (config/v2x.yaml): the V2X channel; the bridge applies the advisories' downlink
+  /// (latency, loss, range, max age), the RSUs the rest. Off by default.
+  v2x::ChannelParams v2x;
   /// Key file of the deployment (palcas_core/message_auth.h): advisory arrays without its
   /// tag are refused. "" = authentication off (any publisher may advise; warned at start).
   std::string auth_key_file;

@@ -53,6 +53,7 @@ struct RunSummary {
   std::uint64_t route_changes_failed = 0;  ///< exit route changes SUMO refused
   sim::GuardCounters guard;  ///< how often the advice guard acted
   std::uint64_t insertion_dropped = 0;  ///< vehicles SUMO dropped at insertion (max_depart_delay_s)
+  v2x::DownlinkCounts downlink;  ///< the advisories' way through the V2X channel
 };
 
 /// Generates the scenario into <out_dir>/scenario and writes manifest.json.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <unordered_set>
 
 namespace palcas::v2x {
 
@@ -139,8 +140,17 @@ RoadSnapshot UplinkView::receive(const RoadSnapshot& truth, std::uint64_t step) 
   RoadSnapshot view;
   view.num_lanes = truth.num_lanes;
   age_in_view_s_.clear();
+  // A vehicle that has left the road leaves every view at once: what else the RSU would know
+  // of a departure (the bridge's removal events) races the states over ROS, and advice for
+  // it could not be carried out anyway.
+  std::unordered_set<std::string_view> on_road;
+  for (const VehicleSnapshot& v : truth.vehicles) on_road.insert(v.id);
   for (auto it = last_.begin(); it != last_.end();) {
     const std::uint64_t age = step - it->second.sent_step;
+    if (!on_road.count(it->first)) {
+      it = last_.erase(it);
+      continue;
+    }
     if (age > max_age) {
       ++counts_.forgotten;
       it = last_.erase(it);

@@ -179,6 +179,7 @@ TEST(UplinkView, LostStatesLeaveTheLastOneUntilItIsTooOld) {
   ChannelParams p = on();
   p.vehicle_state.loss_probability = 0.5;
   p.max_state_age_s = 0.3;
+  p.rsu_range_m = INFINITY;  // it drives 2 km
   const Channel c(p, STEP_S);
   UplinkView view(c, "rsu_0", 0.0);
   RoadSnapshot one;
@@ -215,6 +216,19 @@ TEST(UplinkView, VehiclesBeyondTheRangeAreNeverHeard) {
   EXPECT_EQ(seen.vehicles[0].id, "edge");
   EXPECT_EQ(seen.vehicles[1].id, "near");
   EXPECT_EQ(view.counts().out_of_range, 2u);
+}
+
+TEST(UplinkView, AVehicleThatLeftTheRoadLeavesTheViewAtOnce) {
+  ChannelParams p = on();
+  p.vehicle_state = {0.3, 0.0, 0.0};
+  const Channel c(p, STEP_S);
+  UplinkView view(c, "rsu_0", 0.0);
+  for (std::uint64_t k = 0; k < 5; ++k) view.receive(road(k, 2), k);
+  EXPECT_EQ(view.receive(road(5, 2), 5).vehicles.size(), 2u);
+  // v1 exits: its last state is fresh enough, but it is gone.
+  const RoadSnapshot seen = view.receive(road(6, 1), 6);
+  ASSERT_EQ(seen.vehicles.size(), 1u);
+  EXPECT_EQ(seen.vehicles[0].id, "v0");
 }
 
 TEST(DelayLine, ReleasesInArrivalOrder) {

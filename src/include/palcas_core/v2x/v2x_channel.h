@@ -38,8 +38,9 @@ struct ChannelParams {
   LinkModel advisory;                   ///< downlink
   LinkModel cluster_state;              ///< I2I
   /// An RSU hears and reaches a vehicle within this distance along the road of its position
-  /// (its zone's centre) [m]; +inf = everywhere.
-  double rsu_range_m = std::numeric_limits<double>::infinity();
+  /// (its zone's centre) [m]; +inf = everywhere. 509.4 m: Eclipse MOSAIC SNS's default
+  /// singlehopRadius (a paper-road zone is 800 m: its RSU covers it and ~109 m either side).
+  double rsu_range_m = 509.4;
   double max_advice_age_s = 0.5;  ///< a CAV drops an advisory older than this when it arrives [s]
   double max_state_age_s = 1.0;   ///< an RSU forgets a vehicle whose last state is older [s]
   std::uint64_t seed = 0;         ///< the run's seed: same seed, same losses and delays
@@ -112,6 +113,7 @@ struct UplinkCounts {
 
 /// What one RSU knows of the road through the uplink: the last state each vehicle got through
 /// to it, used as received (stale, not extrapolated) up to max_state_age_s, then forgotten.
+/// A vehicle no longer on the road (absent from the truth) leaves the view at once.
 class UplinkView {
  public:
   /// `rsu_x_m`: where the RSU stands along the road (its zone's centre) [m].
