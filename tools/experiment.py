@@ -38,7 +38,7 @@ ALL_ARMS = LEARNING_ARMS + ("keep", "sumo_native")
 PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..30
 # Settings that define the experiment: a continuation must not change them.
-FIXED_KEYS = ("duration_s", "scenario")
+FIXED_KEYS = ("duration_s", "scenario", "v2x")
 MAX_DEMAND = 100000.0  # veh/h per lane: what the bridge accepts
 
 
@@ -132,6 +132,11 @@ def settings_from_args(a):
                 "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
     if demands is not None:
         settings["demands"] = demands
+    settings["v2x"] = ""
+    if a.v2x:
+        if not os.path.isfile(a.v2x):
+            raise UsageError(f"--v2x {a.v2x}: no such file")
+        settings["v2x"] = os.path.abspath(a.v2x)
     return settings
 
 
@@ -142,6 +147,7 @@ def merge_settings(out, wanted):
     if not f.exists():
         return wanted
     have = json.loads(f.read_text())
+    have.setdefault("v2x", "")  # an experiment from before the channel ran without it
     for key in FIXED_KEYS:
         if have[key] != wanted[key]:
             raise UsageError(f"{out} holds an experiment with {key} = {have[key]}, not "
@@ -269,6 +275,8 @@ def run_point(out, name):
         cmd += ["--policy", settings["policies"][p["arm"]]]
     if not p["trajectories"]:
         cmd += ["--no-trajectories"]
+    if settings.get("v2x"):
+        cmd += ["--v2x", settings["v2x"]]
     env = dict(os.environ, PALCAS_NO_BUILD="1", PALCAS_SHOW="^$")
     start = time.time()
     with open(d / "point.log", "w") as log:
@@ -387,6 +395,7 @@ def common_options(p):
     p.add_argument("--seeds", type=int, default=3)
     p.add_argument("--duration", type=float, default=1800.0)
     p.add_argument("--scenario", default="paper")
+    p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
     p.add_argument("--policy", action="append", metavar="ARM=DIR")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     p.add_argument("--check-only", action="store_true",

@@ -27,6 +27,13 @@ ROWS = [
     ("guard.busy_zone_pct", "Guard: zone time busy (%)", "{:.1f}"),
     ("guard.handback_cav_s", "Guard: CAV-s handed back", "{:.0f}"),
     ("guard.accelerate_guarded_pct", "Guard: ACCELERATE guarded (%)", "{:.1f}"),
+    ("v2x.advisories_sent", "V2X: advisories sent", "{}"),
+    ("v2x.advisories_delivered", "V2X: advisories delivered", "{}"),
+    ("v2x.advisories_applied_late", "V2X: of them late", "{}"),
+    ("v2x.advisories_lost", "V2X: advisories lost", "{}"),
+    ("v2x.advisories_out_of_range", "V2X: advisories out of range", "{}"),
+    ("v2x.advisories_too_old", "V2X: advisories too old", "{}"),
+    ("v2x.advice_mean_age_s", "V2X: mean advice age (s)", "{:.3f}"),
     ("decision_ms_p50", "Decision p50 (ms)", "{:.2f}"),
     ("decision_ms_p90", "Decision p90 (ms)", "{:.2f}"),
     ("decision_ms_p99", "Decision p99 (ms)", "{:.2f}"),
@@ -60,6 +67,9 @@ def main(paths):
     runs = [(pathlib.Path(p).parent.name, json.loads(pathlib.Path(p).read_text())) for p in paths]
     # Rows no run has (e.g. decision latency of a SUMO-native run) are left out.
     rows = [r for r in ROWS if any(lookup(m, r[0]) is not None for _, m in runs)]
+    # The channel's rows only when some run had it on (off, every advisory is delivered at once).
+    if not any(lookup(m, "v2x.enabled") for _, m in runs):
+        rows = [r for r in rows if not r[0].startswith("v2x.")]
     width = max(14, *(len(n) for n, _ in runs))
     print(f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs))
     for key, label, pattern in rows:

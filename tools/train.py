@@ -9,7 +9,7 @@ the checked values; options the user did not give are absent. What is left to ch
 usage: train.py --root REPO --out DIR [--resume] [--arm A] [--episodes N] [--duration S]
                 [--pr P | --pr-range MIN,MAX] [--demand VPHPL | --demand-range MIN,MAX]
                 [--ramp-demand VPH] [--seed N] [--scenario NAME] [--explore-fraction F]
-                [--learning FILE] [--rsu-params FILE] [--bridge-params FILE]
+                [--learning FILE] [--rsu-params FILE] [--bridge-params FILE] [--v2x FILE]
                 [--paper-printed] --command-line TEXT [--check-only]
 
 Demand: --demand sets the mainline demand [veh/h per lane] and --ramp-demand the on-ramp
@@ -169,7 +169,7 @@ def settle_options(given, out, resume):
         raise OptionError("--resume: the exploration schedule is the training's own (%s/learning_schedule.yaml); "
                           "leave --explore-fraction out" % out)
     opts["explore_fraction"] = record["explore_fraction"]
-    for key in ("learning", "rsu_params", "bridge_params"):
+    for key in ("learning", "rsu_params", "bridge_params", "v2x_params"):
         opts[key] = record.get(key, "")
     opts["paper_printed"] = bool(record.get("paper_printed", False))
     return opts, record
@@ -185,6 +185,7 @@ def write_record(out, opts, git_commit):
     record = {"arm": opts["arm"], "scenario": opts["scenario"], "pr": as_number(opts["pr"]), "seed": opts["seed"],
               "episodes": opts["episodes"], "duration_s": as_number(opts["duration"]), "learning": opts.get("learning") or "",
               "rsu_params": opts.get("rsu_params") or "", "bridge_params": opts.get("bridge_params") or "",
+              "v2x_params": opts.get("v2x_params") or "",
               "paper_printed": bool(opts.get("paper_printed")), "explore_fraction": opts["explore_fraction"],
               "demand_vphpl": as_number(opts["demand"]) if opts.get("demand") is not None else None,
               "ramp_demand_vph": as_number(opts["ramp_demand"]) if opts.get("ramp_demand") is not None else None,
@@ -366,6 +367,7 @@ def run_launches(root, out, opts, record, args, interrupt):
             "out_dir:=%s" % out, "learning_params:=%s" % (opts.get("learning") or "none"),
             "rsu_params:=%s" % (opts.get("rsu_params") or "none"),
             "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
+            "v2x_params:=%s" % (opts.get("v2x_params") or "none"),
             "paper_printed:=%s" % str(bool(opts.get("paper_printed"))).lower(), "auth_key_file:=%s" % auth_key,
             "git_commit:=%s" % record["git_commit"], "command_line:=%s" % args.command_line]
         with open(os.path.join(out, "console.log"), "a") as console:
@@ -444,6 +446,7 @@ def parse(argv):
     ap.add_argument("--learning", default="")
     ap.add_argument("--rsu-params", default="")
     ap.add_argument("--bridge-params", default="")
+    ap.add_argument("--v2x", default="", help="a YAML over config/v2x.yaml: train with the V2X channel on")
     ap.add_argument("--paper-printed", action="store_true")
     ap.add_argument("--command-line", default="./palcas train")
     ap.add_argument("--check-only", action="store_true", help="check the options against the record, start nothing")
@@ -469,6 +472,7 @@ def main(argv=None):
         return 0
     if not args.resume:
         opts.update(learning=args.learning, rsu_params=args.rsu_params, bridge_params=args.bridge_params,
+                    v2x_params=args.v2x,
                     paper_printed=args.paper_printed)
     out = args.out or os.path.join(args.results_dir or os.path.join(args.root, "results"), "train-%s-%s" % (
         opts["arm"], datetime.datetime.now().strftime("%Y%m%d-%H%M%S")))
