@@ -11,6 +11,7 @@
 
 #include <palcas_core/model_blob.h>
 #include <palcas_core/state_layout.h>
+#include <palcas_core/v2x/v2x_channel.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/RoadDescription.h>
@@ -239,6 +240,10 @@ struct ReplayedRsu {
   std::unique_ptr<palcas::rsu::PeerStates> peers;
   palcas::rsu::VehicleOutcomes outcomes;
   double last_own_density = std::numeric_limits<double>::quiet_NaN();
+  // The V2X channel's uplink as the live RSU had it (options.v2x.enabled): fed every
+  // recorded step, so a decision sees the same stale and missing states.
+  std::unique_ptr<palcas::v2x::Channel> channel;
+  std::unique_ptr<palcas::v2x::UplinkView> uplink;
   fs::path model;
   Tally tally;
 };
@@ -262,9 +267,11 @@ int run(const Args& args) {
                      "a keep or sumo_native run has no RSU to replay)");
   }
   int lanes_in_states = 0;
+  double step_length_s = 0.0;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC)))
     if (auto s = m.instantiate<palcas_msgs::VehicleStateArray>()) {
       lanes_in_states = s->num_lanes;
+      step_length_s = s->step_length_s;
       break;
     }
   const Road road = readRoad(bag, lanes_in_states);
@@ -352,6 +359,18 @@ int run(const Args& args) {
                        "build (give the learning override the policy was trained with: --learning FILE): " + e.what());
     }
     r.peers = std::make_unique<palcas::rsu::PeerStates>(r.options.controller.cluster_index, r.options.i2i_stale_after_s);
+    if (r.options.v2x.enabled) {
+      // As RsuNode: the zone's centre, no range for the centralized agent.
+      palcas::v2x::ChannelParams p = r.options.v2x;
+      if (r.options.whole_road) p.rsu_range_m = std::numeric_limits<double>::infinity();
+      try {
+        r.channel = std::make_unique<palcas::v2x::Channel>(p, step_length_s);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(id + ": the recorded V2X channel: " + e.what());
+      }
+      const double x_m = r.options.whole_road ? 0.0 : 0.5 * (r.options.controller.x_start_m + r.options.controller.x_end_m);
+      r.uplink = std::make_unique<palcas::v2x::UplinkView>(*r.channel, id, x_m);
+    }
     rsus.push_back(std::move(r));
   }
   const int period = base.decision_period_steps;
@@ -360,9 +379,9 @@ int run(const Args& args) {
   if (!csv) throw InputError("cannot write the CSV '" + args.csv + "'");
   csv << "step,time_s,rsu,vehicle,recorded_action,recorded_accel_mps2,replayed_action,replayed_accel_mps2\n";
 
-  std::printf("replay: %s\n  road: %zu zone(s), %d lanes (state size %d) from %s; decision every %d steps; I2I %s\n",
+  std::printf("replay: %s\n  road: %zu zone(s), %d lanes (state size %d) from %s; decision every %d steps; I2I %s%s\n",
               args.bag.c_str(), road.zones_m.size() - 1, road.num_lanes, state_size, road.source.c_str(), period,
-              i2i ? "on" : "off");
+              i2i ? "on" : "off", base.v2x.enabled ? "; V2X channel on (as recorded: the uplink replayed step by step)" : "");
   for (const ReplayedRsu& r : rsus)
     std::printf("  %s [%.0f, %.0f) m: %s\n", r.id.c_str(), r.options.controller.x_start_m,
                 r.options.controller.x_end_m, r.model.c_str());
@@ -395,6 +414,15 @@ int run(const Args& args) {
                        std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
                        "): replay handles a bag of one episode (./palcas run records one per arm)");
     previous_step = states->step;
+    std::map<std::string, palcas::RoadSnapshot> heard;  // by RSU, with the channel on
+    for (ReplayedRsu& r : rsus)
+      if (r.uplink) {
+        try {
+          heard[r.id] = r.uplink->receive(palcas::rsu::toSnapshot(*states), states->step);
+        } catch (const std::invalid_argument&) {
+          // A malformed state: the live RSU refused it too.
+        }
+      }
     if (states->step % static_cast<std::uint64_t>(period) != 0) continue;
     ++decision_steps;
     const double now_s = states->header.stamp.toSec();
@@ -435,7 +463,10 @@ int run(const Args& args) {
       }
       std::map<std::string, Advice> replayed;
       try {
-        const palcas::rsu::DecisionOutput d = r.controller->advise(snapshot, states->step, now_s, global, r.outcomes);
+        const auto h = heard.find(r.id);
+        if (r.uplink && h == heard.end()) throw std::invalid_argument("malformed state");
+        const palcas::RoadSnapshot& seen = r.uplink ? h->second : snapshot;
+        const palcas::rsu::DecisionOutput d = r.controller->advise(seen, states->step, now_s, global, r.outcomes);
         r.outcomes.clear();
         r.last_own_density = d.cluster.density_veh_per_km;
         for (const auto& a : d.advisories) {
@@ -510,7 +541,7 @@ int run(const Args& args) {
               not_decided ? (", " + std::to_string(not_decided) + " decisions refused a malformed state").c_str() : "");
   if (i2i)
     std::printf("I2I: %lu decision(s) where the live RSU had other peer states than the bag's order gives "
-                "(a message not yet received); replayed with the ones it used\n",
+                "(a message not yet received, or one the V2X channel lost or delayed); replayed with the ones it used\n",
                 static_cast<unsigned long>(i2i_delivered_otherwise));
   return 0;
 }
