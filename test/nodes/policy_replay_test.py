@@ -10,6 +10,7 @@ as model files; an evaluation of A is recorded (60 s). Then:
 Each launch runs on its own master port; the replays start their own.
 """
 import csv
+import json
 import math
 import os
 import re
@@ -78,6 +79,13 @@ class PolicyReplayTest(unittest.TestCase):
                      "policy_dir:=" + cls.policies["A"])
         cls.bag = cls.eval_dir + "/episode.bag"
         assert os.path.exists(cls.bag), log[-3000:]
+        # The same policy through an impaired V2X channel (late, lost, out-of-range states).
+        cls.v2x_dir = cls.tmp + "/eval_A_v2x"
+        os.makedirs(cls.v2x_dir)
+        log = launch(cls.v2x_dir, "mode:=eval", "seed:=11", "duration:=60", "record:=true",
+                     "policy_dir:=" + cls.policies["A"], "v2x_params:=%s/launch/v2x_impaired.yaml" % TESTS)
+        cls.v2x_bag = cls.v2x_dir + "/episode.bag"
+        assert os.path.exists(cls.v2x_bag), log[-3000:]
 
     @classmethod
     def tearDownClass(cls):
@@ -103,6 +111,17 @@ class PolicyReplayTest(unittest.TestCase):
             used = [math.isfinite(m.i2i_upstream_density_veh_per_km) or math.isfinite(m.i2i_downstream_density_veh_per_km)
                     for _, m, _ in bag.read_messages(topics=["/advisories"]) if m.advisories]
         self.assertGreater(sum(used), len(used) // 2, "most decisions should have used a peer's density")
+
+    def test_a_recording_through_the_v2x_channel_replays_exactly(self):
+        r = replay(self.v2x_bag, "--policy", self.policies["A"], "--csv", self.tmp + "/v2x.csv")
+        print(r.stdout)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        self.assertIn("V2X channel on (as recorded", r.stdout)
+        compared, percent = agreement(r.stdout)
+        self.assertGreater(compared, 30, r.stdout)
+        self.assertEqual(percent, 100.0, r.stdout)
+        with open(self.v2x_dir + "/metrics.json") as f:
+            self.assertGreater(json.load(f)["v2x"]["advisories_lost"], 0)
 
     def test_another_policy_reports_where_it_differs(self):
         out_csv = self.tmp + "/other.csv"
