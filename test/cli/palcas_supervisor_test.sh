@@ -155,3 +155,17 @@ sigterm_case train_sigterm_leaves_nothing "$WORK/t2" 143 yes \
   --learning "$ROOT/config/training/tiny_fast_learning.yaml" --out "$WORK/t2"
 sigterm_case run_sigterm_leaves_nothing "$WORK/r2" 143 no \
   "$ROOT/palcas" run --arm keep --no-compare --scenario tiny --duration 100000 --out "$WORK/r2"
+
+# An RSU started on its own in eval mode without policy_dir (rsu.launch, no bridge): it exits
+# at once with a FATAL saying what to give, instead of waiting for a bridge (register_timeout_s
+# 60 s) and then evaluating random weights.
+port="$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
+ROS_MASTER_URI="http://127.0.0.1:$port" ROS_LOG_DIR="$WORK/rsu_eval_log" timeout -k 5 30 \
+  roslaunch -p "$port" palcas_launch rsu.launch index:=0 mode:=eval policy_dir:= >"$WORK/rsu_eval.log" 2>&1
+why=""
+if ! grep -aq "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR" "$WORK/rsu_eval.log"; then
+  why="no FATAL naming policy_dir within 30 s: $(grep -a -i "fatal\|error" "$WORK/rsu_eval.log" | head -3)"
+elif ! grep -aq "\[rsu_0/rsu-[0-9]*\] process has died .*exit code 1" "$WORK/rsu_eval.log"; then
+  why="the RSU did not exit with code 1: $(tail -3 "$WORK/rsu_eval.log")"
+fi
+result rsu_refuses_eval_without_weights "$why"
