@@ -22,6 +22,7 @@ import tempfile
 import unittest
 
 import rosbag
+import rospy
 import rospkg
 import rostest
 from rosgraph_msgs.msg import Clock
@@ -167,6 +168,20 @@ class PolicyReplayTest(unittest.TestCase):
         r = replay(other, "--policy", self.policies["A"])
         self.assertEqual(r.returncode, 1, r.stdout)
         self.assertIn("recorded with another definition of palcas_msgs/AdvisoryArray", r.stdout)
+
+        # Two episodes in one bag (a training's record): the steps go back; refused, naming it.
+        two = self.tmp + "/two_episodes.bag"
+        with rosbag.Bag(self.bag) as src, rosbag.Bag(two, "w") as dst:
+            msgs = list(src.read_messages(topics=["/vehicle_states", "/advisories", "/road_description", "/rsu_params"]))
+            for topic, msg, t in msgs:
+                dst.write(topic, msg, t)
+            # The second episode's first steps, recorded after the first episode ended.
+            end = msgs[-1][2]
+            for topic, msg, t in [m for m in msgs if m[0] == "/vehicle_states"][:20]:
+                dst.write(topic, msg, end + (t - msgs[0][2]) + rospy.Duration(1))
+        r = replay(two, "--policy", self.policies["A"])
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("the bag holds more than one episode", r.stdout)
 
         empty = tempfile.mkdtemp(dir=self.tmp)
         r = replay(self.bag, "--policy", empty)
