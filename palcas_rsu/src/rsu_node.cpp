@@ -222,6 +222,11 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
              100.0 * p.cluster_state.loss_probability, p.rsu_range_m, x_m, p.max_state_age_s);
   }
   first_state_ = false;
+  if (uplink_ && last_state_step_ && msg->step <= *last_state_step_) {
+    uplink_->clear();  // a new episode: nothing heard yet, nothing in flight
+    i2i_in_flight_.clear();
+  }
+  last_state_step_ = msg->step;
   if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) {
     decide(*msg, received);
     return;

@@ -169,3 +169,24 @@ elif ! grep -aq "\[rsu_0/rsu-[0-9]*\] process has died .*exit code 1" "$WORK/rsu
   why="the RSU did not exit with code 1: $(tail -3 "$WORK/rsu_eval.log")"
 fi
 result rsu_refuses_eval_without_weights "$why"
+
+# Training through the V2X channel, two episodes in one launch: the RSUs' view of the road
+# starts afresh with the second episode (its steps start again at 0) and both advise;
+# train.json records the channel file.
+status=0
+PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 2 --duration 60 \
+  --learning "$ROOT/config/training/tiny_fast_learning.yaml" --v2x "$ROOT/test/launch/v2x_impaired.yaml" \
+  --out "$WORK/train_v2x" >"$WORK/train_v2x.log" 2>&1 || status=$?
+why=""
+if [ "$status" -ne 0 ]; then why="exit $status: $(tail -3 "$WORK/train_v2x.log")"
+elif ! grep -q '"v2x_params": ".*/test/launch/v2x_impaired.yaml"' "$WORK/train_v2x/train.json"; then
+  why="train.json does not record the channel: $(cat "$WORK/train_v2x/train.json")"
+else
+  for e in 0 1; do
+    if ! /usr/bin/python3 -c 'import json, sys; v = json.load(open(sys.argv[1]))["v2x"]; sys.exit(0 if v["enabled"] and v["advisories_delivered"] > 50 and v["advisories_lost"] > 0 else 1)' \
+      "$WORK/train_v2x/episode_$e/metrics.json"; then
+      why="episode $e advised too little through the channel: $(head -c 400 "$WORK/train_v2x/episode_$e/metrics.json")"
+    fi
+  done
+fi
+result train_through_the_v2x_channel_two_episodes "$why"

@@ -20,6 +20,7 @@
 #include <future>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "palcas_rsu/federation_transport.h"
@@ -75,6 +76,9 @@ class RsuNode {
   std::unique_ptr<v2x::UplinkView> uplink_;
   v2x::DelayLine<palcas_msgs::ClusterState> i2i_in_flight_;
   std::uint64_t i2i_lost_ = 0, i2i_received_ = 0;
+  /// The last state's step: a step not after it starts a new episode (the bridge runs
+  /// several in one launch), and the channel's view starts afresh.
+  std::optional<std::uint64_t> last_state_step_;
   /// The road as this RSU hears it at the state's step (the uplink; the state itself when
   /// the channel is off). @throws std::invalid_argument for a malformed state.
   RoadSnapshot heard(const palcas_msgs::VehicleStateArray& msg);
