@@ -26,12 +26,13 @@ import eval_table  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
+import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
 
 def args(**kw):
     base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
-                policy=None, jobs=1, check_only=False, demands=None)
+                policy=None, jobs=1, check_only=False, demands=None, v2x="")
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -123,6 +124,17 @@ class PlannerTest(unittest.TestCase):
             experiment.merge_settings(self.out, experiment.settings_from_args(args()))
         merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(demands="1800,1400")))
         self.assertEqual(merged["demands"], [1400.0, 1800.0])
+
+    def test_a_channel_is_part_of_the_settings(self):
+        with self.assertRaises(experiment.UsageError) as e:
+            experiment.settings_from_args(args(v2x="/no/such/v2x.yaml"))
+        self.assertIn("--v2x /no/such/v2x.yaml: no such file", str(e.exception))
+        experiment.save_settings(self.out, experiment.settings_from_args(args()))
+        channel = self.out / "v2x.yaml"
+        channel.write_text("v2x: {enabled: true}\n")
+        with self.assertRaises(experiment.UsageError) as e:
+            experiment.merge_settings(self.out, experiment.settings_from_args(args(v2x=str(channel))))
+        self.assertIn("v2x", str(e.exception))
 
     def test_continuation_extends_but_never_changes_duration(self):
         s = experiment.settings_from_args(args())
@@ -316,6 +328,45 @@ class EvalTableTest(unittest.TestCase):
         self.assertIn("(worst 40.0, run-s101)", out)
         self.assertIn("JAM: keep in run-s102: 9.00 m/s < 0.5 x sumo_native's 20.00 m/s", out)
         self.assertNotIn("JAM: sumo_native", out)
+        shutil.rmtree(base, ignore_errors=True)
+
+
+class V2xTableTest(unittest.TestCase):
+    """tools/v2x_table.py: a row per channel setting, ratios to SUMO-native of the same seed."""
+
+    def write(self, out, v2x_file, arms, speeds, v2x=None):
+        (out).mkdir(parents=True)
+        (out / "experiment.json").write_text(json.dumps({"v2x": v2x_file}))
+        for arm in arms:
+            for seed, speed in zip((101, 102), speeds[arm]):
+                d = out / "points" / f"{arm}_pr60_s{seed}"
+                (d / arm).mkdir(parents=True)
+                (d / "point.json").write_text(json.dumps({"arm": arm, "seed": seed}))
+                m = {"efficiency_all_mps": speed, "dsr_pct": 95.0, "msr_pct": 99.0, "collision_rate_pct": 0.0,
+                     "comfort_share_pct": 85.0, "decision_ms_p99": 2.0}
+                if v2x:
+                    m["v2x"] = v2x
+                (d / arm / "metrics.json").write_text(json.dumps(m))
+
+    def test_a_row_per_setting_against_sumo_native_of_the_same_seed(self):
+        base = pathlib.Path(tempfile.mkdtemp(prefix="palcas_v2x_test_"))
+        self.write(base / "off", "", ("palcas", "keep", "sumo_native"),
+                   {"palcas": (27.0, 28.0), "keep": (28.0, 28.0), "sumo_native": (30.0, 28.0)})
+        link = {"latency_s": 0.1, "jitter_s": 0.0, "loss_probability": 0.1}
+        self.write(base / "impaired", "/x/impaired.yaml", ("palcas",), {"palcas": (24.0, 28.0)},
+                   v2x={"vehicle_state": link, "advisory": link, "cluster_state": link, "advisories_sent": 100,
+                        "advisories_lost": 10, "advisories_applied_late": 90, "advisories_out_of_range": 0,
+                        "advisories_too_old": 0, "advice_mean_age_s": 0.1})
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            v2x_table.main([str(base / "off"), str(base / "impaired")])
+        lines = text.getvalue().splitlines()
+        off = next(l for l in lines if l.startswith("| palcas, off"))
+        impaired = next(l for l in lines if l.startswith("| palcas, 100 ms, 10 % lost"))
+        self.assertIn("(worst 0.900)", off)       # 27 / 30 on seed 101
+        self.assertIn("(worst 0.800)", impaired)  # 24 / 30 on seed 101
+        self.assertIn("| 10.0 | 90.0 | 0.0 | 0.0 | 0.10 |", impaired)
+        self.assertTrue(any(l.startswith("| keep (no advice to impair)") for l in lines))
         shutil.rmtree(base, ignore_errors=True)
 
 
