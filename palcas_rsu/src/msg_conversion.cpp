@@ -55,6 +55,29 @@ palcas_msgs::ClusterState toMsg(const ClusterSummary& s, const RsuControllerOpti
   return m;
 }
 
+palcas_msgs::RsuStatus toStatusMsg(const RsuControllerStats& s, const StatusContext& context) {
+  palcas_msgs::RsuStatus status;
+  status.header = context.header;
+  status.step = context.step;
+  status.rsu_id = context.rsu_id;
+  status.mode = context.train ? "train" : "eval";
+  status.decision_ms = context.decision_ms;
+  status.members = s.member_count;
+  status.action_counts.assign(s.action_counts.begin(), s.action_counts.end());
+  status.mean_reward = s.mean_reward;
+  status.sum_reward = s.sum_reward;
+  status.q_loss = s.q_loss;
+  status.param_loss = s.param_loss;
+  status.epsilon = s.epsilon;
+  status.gradient_steps = s.gradient_steps;
+  status.samples_since_federation = s.samples_since_federation;
+  status.model_version = s.model_version;
+  status.federation_round = s.federation_round;
+  status.stale_peers = context.stale_peers;
+  status.federation_reachable = context.federation_reachable;
+  return status;
+}
+
 void addOutcomes(const palcas_msgs::VehicleEventArray& events, VehicleOutcomes& outcomes) {
   for (const auto& e : events.events) {
     if (e.kind >= metrics::VEHICLE_EVENT_KIND_COUNT) continue;  // a newer bridge's kind

@@ -317,26 +317,15 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
       decisions_ % static_cast<std::uint64_t>(options_.checkpoint_every_decisions) == 0)
     checkpoint();
 
-  const RsuControllerStats s = controller_->stats();
-  palcas_msgs::RsuStatus status;
-  status.header = msg.header;
-  status.step = msg.step;
-  status.rsu_id = c.rsu_id;
-  status.mode = c.train ? "train" : "eval";
-  status.decision_ms = out.decision_ms;
-  status.members = s.member_count;
-  status.action_counts.assign(s.action_counts.begin(), s.action_counts.end());
-  status.mean_reward = s.mean_reward;
-  status.sum_reward = s.sum_reward;
-  status.q_loss = s.q_loss;
-  status.param_loss = s.param_loss;
-  status.epsilon = s.epsilon;
-  status.gradient_steps = s.gradient_steps;
-  status.samples_since_federation = s.samples_since_federation;
-  status.model_version = s.model_version;
-  status.federation_round = s.federation_round;
-  status.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
-  status.federation_reachable = federation_ && federation_->reachable();
+  StatusContext context;
+  context.header = msg.header;
+  context.step = msg.step;
+  context.rsu_id = c.rsu_id;
+  context.train = c.train;
+  context.decision_ms = out.decision_ms;
+  context.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
+  context.federation_reachable = federation_ && federation_->reachable();
+  const palcas_msgs::RsuStatus status = toStatusMsg(controller_->stats(), context);
   status_pub_.publish(status);
   last_status_ = status;
   recent_decision_ms_.add(out.decision_ms);
