@@ -38,6 +38,20 @@ def bridge_line(trained_with, runs_with, as_trained):
         f"`{pathlib.Path(trained_with).name}` over it" if trained_with else "it") + ")"
 
 
+def traffic_text(train):
+    """The training's PR and demand as train.json holds them: fixed, or drawn per episode."""
+    def span(r):
+        return f"{r[0]:g}-{r[1]:g}"
+    pr = f"PR drawn per episode from {span(train['pr_range'])} %" if train.get("pr_range") else f"PR {train['pr']} %"
+    if train.get("demand_range"):
+        demand = f"mainline demand drawn per episode from {span(train['demand_range'])} veh/h/lane"
+    elif train.get("demand_vphpl") is not None:
+        demand = f"mainline demand {train['demand_vphpl']:g} veh/h/lane"
+    else:
+        demand = "the scenario's demand"
+    return f"{pr}, {demand}" + (f", V2X channel `{train['v2x_params']}`" if train.get("v2x_params") else "")
+
+
 def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None, default_from=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
@@ -100,7 +114,7 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         f"# Training record of this policy ({train['arm']})",
         "",
         f"- command: `{manifest.get('command_line', '(unknown)')}`",
-        f"- road {train['scenario']}, PR {train['pr']} %, {train['episodes']} x {train['duration_s']:.0f} s, "
+        f"- road {train['scenario']}, {traffic_text(train)}, {train['episodes']} x {train['duration_s']:.0f} s, "
         f"exploration over {100 * float(train.get('explore_fraction', 0.5)):.0f} % of the budget"
         + (", paper as printed" if train.get("paper_printed") else ", config/departures.yaml"),
         f"- commit: `{manifest.get('git_commit') or train.get('git_commit', 'unknown')}`",

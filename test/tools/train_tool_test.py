@@ -351,6 +351,19 @@ class ShipPolicy(unittest.TestCase):
         self.assertIn("no such file /nonexistent.yaml", str(e.exception.code))
         self.assertTrue((dest / "bridge.yaml").exists())  # the folder shipped before is kept
 
+    def test_the_record_says_how_pr_and_demand_were_drawn(self):
+        src = self.training("")
+        record = json.loads((src / "train.json").read_text())
+        record.update(pr_range=[5.0, 60.0], demand_range=[800.0, 2400.0])
+        (src / "train.json").write_text(json.dumps(record))
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(src), str(dest), rsu_models=True)
+        text = (dest / "TRAINING.md").read_text()
+        self.assertIn("PR drawn per episode from 5-60 %, mainline demand drawn per episode from 800-2400 veh/h/lane",
+                      text)
+        self.assertEqual(ship_policy.traffic_text(dict(pr=60, demand_vphpl=1000.0)),
+                         "PR 60 %, mainline demand 1000 veh/h/lane")
+
     def test_rsu_models_ship_the_global_model_as_the_default_for_zones_without_their_own(self):
         src = self.training("")
         (src / "checkpoints/fedserver").mkdir()
