@@ -466,7 +466,10 @@ int run(const Args& args) {
         const auto h = heard.find(r.id);
         if (r.uplink && h == heard.end()) throw std::invalid_argument("malformed state");
         const palcas::RoadSnapshot& seen = r.uplink ? h->second : snapshot;
-        const palcas::rsu::DecisionOutput d = r.controller->advise(seen, states->step, now_s, global, r.outcomes);
+        // As RsuNode: over the channel, an evaluating RSU decides without the removal events.
+        const palcas::rsu::VehicleOutcomes none;
+        const palcas::rsu::DecisionOutput d =
+            r.controller->advise(seen, states->step, now_s, global, r.uplink ? none : r.outcomes);
         r.outcomes.clear();
         r.last_own_density = d.cluster.density_veh_per_km;
         for (const auto& a : d.advisories) {

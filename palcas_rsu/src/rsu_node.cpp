@@ -1,5 +1,7 @@
 #include "palcas_rsu/rsu_node.h"
 
+#include <ros/master.h>
+
 #include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
 #include <palcas_common/model_weights.h>
@@ -147,8 +149,23 @@ void RsuNode::waitForPeers() {
   // The RSU also hears itself (an intra-process link on the shared topic): peers + 1.
   const uint32_t links = peers + 1;
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
+  // Every subscriber the master knows of (peers, and a recorder if any) must have connected
+  // to this RSU's publisher: counting peers alone, a recorder's link could stand in for a
+  // peer's that is still being made, and that peer would miss the first cluster states.
+  const std::string topic = cluster_pub_.getTopic();
+  auto known_subscribers = [&topic]() -> uint32_t {
+    XmlRpc::XmlRpcValue request, response, payload;
+    request[0] = ros::this_node::getName();
+    if (!ros::master::execute("getSystemState", request, response, payload, false) || payload.size() < 2)
+      return 0;
+    const XmlRpc::XmlRpcValue& subscribers = payload[1];
+    for (int i = 0; i < subscribers.size(); ++i)
+      if (static_cast<std::string>(subscribers[i][0]) == topic) return static_cast<uint32_t>(subscribers[i][1].size());
+    return 0;
+  };
   while (ros::ok() && ros::WallTime::now() < deadline &&
-         (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links))
+         (cluster_pub_.getNumSubscribers() < std::max(links, known_subscribers()) ||
+          cluster_sub_.getNumPublishers() < links))
     ros::WallDuration(0.02).sleep();
   if (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links)
     ROS_WARN("%s: I2I: %u of %u peers connected after %.0f s; starting anyway (their states "
@@ -289,7 +306,11 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
                                                 : GlobalDensities{unknown, unknown, unknown};
     out.i2i_upstream_density_veh_per_km = global.upstream;
     out.i2i_downstream_density_veh_per_km = global.downstream;
-    decision = controller_->advise(snapshot, msg.step, now_s, global, outcomes_);
+    // Evaluating over the V2X channel, membership comes from what reached the RSU alone: the
+    // bridge's removal events race the states over ROS and would decide a stale vehicle's
+    // membership by arrival order. Training keeps them (its terminal rewards).
+    const VehicleOutcomes none;
+    decision = controller_->advise(snapshot, msg.step, now_s, global, uplink_ && !c.train ? none : outcomes_);
     outcomes_.clear();
     last_own_density_ = decision.cluster.density_veh_per_km;
   } catch (const std::invalid_argument& e) {
