@@ -414,11 +414,12 @@ int run(const Args& args) {
                        std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
                        "): replay handles a bag of one episode (./palcas run records one per arm)");
     previous_step = states->step;
+    const palcas::RoadSnapshot snapshot = palcas::rsu::toSnapshot(*states);  // once per step
     std::map<std::string, palcas::RoadSnapshot> heard;  // by RSU, with the channel on
     for (ReplayedRsu& r : rsus)
       if (r.uplink) {
         try {
-          heard[r.id] = r.uplink->receive(palcas::rsu::toSnapshot(*states), states->step);
+          heard[r.id] = r.uplink->receive(snapshot, states->step);
         } catch (const std::invalid_argument&) {
           // A malformed state: the live RSU refused it too.
         }
@@ -444,7 +445,6 @@ int run(const Args& args) {
           }
         }
     }
-    const palcas::RoadSnapshot snapshot = palcas::rsu::toSnapshot(*states);
     for (ReplayedRsu& r : rsus) {
       const double unknown = std::numeric_limits<double>::quiet_NaN();
       const auto key = std::make_pair(states->step, r.id);
