@@ -4,8 +4,8 @@
 #include <palcas_msgs/FederationStatus.h>
 #include <std_msgs/UInt32.h>
 
-#include <palcas_core/pdqn_agent.h>
-#include <palcas_core/state_layout.h>
+#include <palcas_core/learning/pdqn_agent.h>
+#include <palcas_core/state/state_layout.h>
 
 #include <fstream>
 #include <sstream>

@@ -9,8 +9,8 @@
 // overrides) are read from the parameter server under ~ exactly as the node reads them;
 // `./palcas replay` starts a private master and loads them.
 
-#include <palcas_core/model_blob.h>
-#include <palcas_core/state_layout.h>
+#include <palcas_core/learning/model_blob.h>
+#include <palcas_core/state/state_layout.h>
 #include <palcas_core/v2x/v2x_channel.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>

@@ -8,7 +8,7 @@
 
 #include "palcas_common/core_params.h"
 #include "palcas_common/v2x_params.h"
-#include "palcas_core/state_layout.h"
+#include "palcas_core/state/state_layout.h"
 
 namespace palcas::rsu {
 

@@ -1,7 +1,7 @@
 // The advisory message constants must mirror palcas_core's action enum, since the RSU
 // converts one into the other by value.
 #include <gtest/gtest.h>
-#include <palcas_core/action.h>
+#include <palcas_core/common/action.h>
 #include <palcas_msgs/Advisory.h>
 
 TEST(ActionCodes, MessageConstantsMirrorCoreEnum) {

@@ -4,7 +4,7 @@
 #include <limits>
 #include <palcas_common/bridge_road.h>
 #include <palcas_common/message_auth.h>
-#include <palcas_core/advisory_validator.h>
+#include <palcas_core/metrics/advisory_validator.h>
 #include <palcas_msgs/AdvisoryRejection.h>
 #include <palcas_msgs/EpisodeMetrics.h>
 #include <palcas_msgs/RoadDescription.h>

@@ -25,8 +25,8 @@
 #include <string>
 #include <vector>
 
-#include "palcas_core/fedavg.h"
-#include "palcas_core/pdqn_agent.h"
+#include "palcas_core/learning/fedavg.h"
+#include "palcas_core/learning/pdqn_agent.h"
 
 using namespace palcas;
 using Clock = std::chrono::steady_clock;

@@ -1,8 +1,9 @@
-# federation sources: the federation server's round logic (ROS-free; palcas_fedserver wraps it)
-# and the HMAC tags that authenticate advisories and model submissions
+# federation sources (lib/federation/): both sides of a federation round, ROS-free: the
+# server's round logic and checkpoints (palcas_fedserver wraps it) and the RSU's client
+# (rounds, submissions, heartbeats, reconnects; palcas_rsu wraps it)
 list(APPEND PALCAS_CORE_SOURCES
-  lib/federation_server.cpp
-  lib/federation_checkpoint.cpp
-  lib/federation_json.cpp
-  lib/message_auth.cpp
+  lib/federation/federation_server.cpp
+  lib/federation/federation_checkpoint.cpp
+  lib/federation/federation_json.cpp
+  lib/federation/federation_client.cpp
 )

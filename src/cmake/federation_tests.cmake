@@ -1,4 +1,4 @@
-# federation tests: rounds, rejections, liveness, checkpoints of FederationServer
-palcas_core_add_gtest(federation_server_test test/federation_server_test.cpp)
-# message authentication: HMAC-SHA256 vectors, tampering, key files
-palcas_core_add_gtest(message_auth_test test/message_auth_test.cpp)
+# federation tests (test/federation/): rounds, rejections, liveness, checkpoints of
+# FederationServer; FederationClient against an in-process server
+palcas_core_add_gtest(federation_server_test test/federation/federation_server_test.cpp)
+palcas_core_add_gtest(federation_client_test test/federation/federation_client_test.cpp)

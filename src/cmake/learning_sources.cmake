@@ -1,20 +1,20 @@
-# learning sources: neural networks on Eigen, PDQN agent, replay, FedAvg
+# learning sources (lib/learning/): neural networks on Eigen (nn/), model blobs, replay,
+# PDQN agent, FedAvg
 list(APPEND PALCAS_CORE_SOURCES
-  lib/rng.cpp
-  lib/nn/linear.cpp
-  lib/nn/relu.cpp
-  lib/nn/tanh.cpp
-  lib/nn/batch_norm.cpp
-  lib/nn/dropout.cpp
-  lib/nn/network.cpp
-  lib/nn/folded_network.cpp
-  lib/nn/huber_loss.cpp
-  lib/nn/adamw.cpp
-  lib/nn/serialization.cpp
-  lib/model_blob.cpp
-  lib/replay_buffer.cpp
-  lib/pdqn_config.cpp
-  lib/pdqn_agent.cpp
-  lib/pdqn_agent_io.cpp
-  lib/fedavg.cpp
+  lib/learning/nn/linear.cpp
+  lib/learning/nn/relu.cpp
+  lib/learning/nn/tanh.cpp
+  lib/learning/nn/batch_norm.cpp
+  lib/learning/nn/dropout.cpp
+  lib/learning/nn/network.cpp
+  lib/learning/nn/folded_network.cpp
+  lib/learning/nn/huber_loss.cpp
+  lib/learning/nn/adamw.cpp
+  lib/learning/nn/serialization.cpp
+  lib/learning/model_blob.cpp
+  lib/learning/replay_buffer.cpp
+  lib/learning/pdqn_config.cpp
+  lib/learning/pdqn_agent.cpp
+  lib/learning/pdqn_agent_io.cpp
+  lib/learning/fedavg.cpp
 )

@@ -1,6 +1,7 @@
-# metrics sources: episode bookkeeping (events, outcome tracker, metrics, advisory gate)
+# metrics sources (lib/metrics/): episode bookkeeping (events, outcome tracker, metrics,
+# advisory gate)
 list(APPEND PALCAS_CORE_SOURCES
-  lib/vehicle_event.cpp
-  lib/outcome_tracker.cpp
-  lib/episode_metrics.cpp
-  lib/advisory_validator.cpp)
+  lib/metrics/vehicle_event.cpp
+  lib/metrics/outcome_tracker.cpp
+  lib/metrics/episode_metrics.cpp
+  lib/metrics/advisory_validator.cpp)

@@ -37,5 +37,5 @@ TEST(NoRosHeaders, DetectorRecognisesRosIncludes) {
   EXPECT_TRUE(std::regex_search("#include <ros/ros.h>", ros_include));
   EXPECT_TRUE(std::regex_search("  #include \"palcas_msgs/Advisory.h\"", ros_include));
   EXPECT_FALSE(std::regex_search("#include <Eigen/Dense>", ros_include));
-  EXPECT_FALSE(std::regex_search("#include \"palcas_core/action.h\"", ros_include));
+  EXPECT_FALSE(std::regex_search("#include \"palcas_core/common/action.h\"", ros_include));
 }

@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "palcas_core/reward.h"
+#include "palcas_core/reward/reward.h"
 
 namespace {
 

@@ -23,7 +23,8 @@ why=""
 [ -n "$why" ] || [ -f "$INSTALL/setup.bash" ] || why="no $INSTALL/setup.bash"
 for f in share/palcas_launch/system.launch share/palcas_config/bridge.yaml \
          share/palcas_config/policies/palcas/checkpoints/rsu_0/model.palcas lib/palcas_sumo_bridge/bridge_node \
-         lib/palcas_rsu/rsu_node lib/palcas_fedserver/fedserver_node; do
+         lib/palcas_rsu/rsu_node lib/palcas_fedserver/fedserver_node \
+         include/palcas_core/rsu/rsu_controller.h include/palcas_core/learning/nn/network.h; do
   [ -n "$why" ] || [ -e "$INSTALL/$f" ] || why="the install space lacks $f"
 done
 result install_space_complete "$why"

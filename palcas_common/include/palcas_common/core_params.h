@@ -6,9 +6,9 @@
 // ~state_scales/* (config/rsu.yaml). Every key is optional: absent = the paper's default
 // compiled into the struct; present = checked. Header-only.
 
-#include <palcas_core/pdqn_config.h>
-#include <palcas_core/reward.h>
-#include <palcas_core/state_builder.h>
+#include <palcas_core/learning/pdqn_config.h>
+#include <palcas_core/reward/reward.h>
+#include <palcas_core/state/state_builder.h>
 #include <palcas_common/param_reader.h>
 
 #include <limits>

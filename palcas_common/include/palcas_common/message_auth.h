@@ -5,7 +5,7 @@
 // weight) breaks it. The serialisation is ROS's wire format: rospy computes the same bytes
 // (test/nodes/forged_messages_test.py signs from Python).
 
-#include <palcas_core/message_auth.h>
+#include <palcas_core/common/message_auth.h>
 #include <ros/serialization.h>
 
 #include <cstdint>

@@ -3,7 +3,7 @@
 // and the federation server. A round trip keeps every field bit for bit; non-finite values
 // pass through for the server's checks to refuse.
 
-#include <palcas_core/model_blob.h>
+#include <palcas_core/learning/model_blob.h>
 #include <palcas_msgs/ModelWeights.h>
 
 #include <cstdint>

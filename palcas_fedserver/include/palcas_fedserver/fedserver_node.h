@@ -8,8 +8,8 @@
 #include <palcas_msgs/SubmitWeights.h>
 #include <ros/ros.h>
 
-#include <palcas_core/federation_server.h>
-#include <palcas_core/message_auth.h>
+#include <palcas_core/common/message_auth.h>
+#include <palcas_core/federation/federation_server.h>
 
 #include <memory>
 

@@ -8,8 +8,8 @@
 
 #include <string>
 
-#include <palcas_core/federation_server.h>
-#include <palcas_core/pdqn_config.h>
+#include <palcas_core/federation/federation_server.h>
+#include <palcas_core/learning/pdqn_config.h>
 
 namespace palcas::fedserver {
 
@@ -18,8 +18,8 @@ struct FedServerOptions {
   /// ~learning/*: builds the initial global model (PdqnAgent(learning).exportModel()).
   PdqnConfig learning;
   std::string checkpoint_dir;            ///< "" = no checkpoints
-  /// The deployment's key file (palcas_core/message_auth.h): submissions without its tag are
-  /// refused (counted as unauthenticated), served global models carry it. "" = off.
+  /// The deployment's key file (palcas_core/common/message_auth.h): submissions without its
+  /// tag are refused (counted as unauthenticated), served global models carry it. "" = off.
   std::string auth_key_file;
   bool resume = false;                   ///< start from checkpoint_dir instead of a fresh model
   double poll_period_s = 0.5;            ///< ROS-time period of the round-closing timer [s]

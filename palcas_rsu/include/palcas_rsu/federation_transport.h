@@ -4,8 +4,8 @@
 // A call that fails drops its persistent connection, so the next one connects afresh to a
 // restarted server.
 
-#include <palcas_core/federation_client.h>
-#include <palcas_core/message_auth.h>
+#include <palcas_core/common/message_auth.h>
+#include <palcas_core/federation/federation_client.h>
 #include <ros/ros.h>
 
 namespace palcas::rsu {

@@ -3,8 +3,8 @@
 // ModelWeights <-> ModelBlob, shared with the federation server, is in
 // palcas_common/model_weights.h.
 
-#include <palcas_core/road_snapshot.h>
-#include <palcas_core/rsu_controller.h>
+#include <palcas_core/common/road_snapshot.h>
+#include <palcas_core/rsu/rsu_controller.h>
 #include <palcas_msgs/Advisory.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/RsuStatus.h>

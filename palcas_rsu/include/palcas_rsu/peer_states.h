@@ -7,7 +7,7 @@
 // of simulation time is stale: its density is reported unknown (NaN, which the state
 // encodes explicitly) and the RSU keeps working with what it has.
 
-#include <palcas_core/road_snapshot.h>
+#include <palcas_core/common/road_snapshot.h>
 
 #include <map>
 #include <string>

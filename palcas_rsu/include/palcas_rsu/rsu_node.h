@@ -6,10 +6,10 @@
 // the federation exchange without blocking the advisories.
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <palcas_core/controller_model.h>
-#include <palcas_core/federation_client.h>
-#include <palcas_core/learning_log.h>
-#include <palcas_core/message_auth.h>
+#include <palcas_core/common/message_auth.h>
+#include <palcas_core/federation/federation_client.h>
+#include <palcas_core/rsu/controller_model.h>
+#include <palcas_core/rsu/learning_log.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/VehicleEventArray.h>

@@ -3,7 +3,7 @@
 // of the parameter server). Keys: README.md of this package; config/rsu.yaml (~rsu/*,
 // ~state_scales/*), config/reward.yaml (~reward/*), config/learning.yaml (~learning/*).
 
-#include <palcas_core/rsu_controller.h>
+#include <palcas_core/rsu/rsu_controller.h>
 #include <palcas_core/v2x/v2x_channel.h>
 #include <palcas_common/param_reader.h>
 #include <ros/node_handle.h>
@@ -25,8 +25,9 @@ struct RsuNodeOptions {
   bool learner_thread = true;
   std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
   std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
-  /// The deployment's key file (palcas_core/message_auth.h): advisories and submissions are
-  /// signed with it, a global model without its tag is refused. "" = authentication off.
+  /// The deployment's key file (palcas_core/common/message_auth.h): advisories and
+  /// submissions are signed with it, a global model without its tag is refused. "" =
+  /// authentication off.
   std::string auth_key_file;
   bool resume = false;               ///< continue from the checkpoint in checkpoint_dir
   int checkpoint_every_decisions = 600;  ///< 0 = only at shutdown; 600 = every 10 sim minutes

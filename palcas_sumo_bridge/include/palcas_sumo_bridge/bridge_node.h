@@ -5,7 +5,7 @@
 // for step k, apply them, advance SUMO to step k+1, measure.
 
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <palcas_core/message_auth.h>
+#include <palcas_core/common/message_auth.h>
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/RegisterRsu.h>
 #include <palcas_msgs/VehicleStateArray.h>

@@ -38,8 +38,8 @@ struct BridgeOptions {
   /// ~v2x/* (config/v2x.yaml): the V2X channel; the bridge applies the advisories' downlink
   /// (latency, loss, range, max age), the RSUs the rest. Off by default.
   v2x::ChannelParams v2x;
-  /// Key file of the deployment (palcas_core/message_auth.h): advisory arrays without its
-  /// tag are refused. "" = authentication off (any publisher may advise; warned at start).
+  /// Key file of the deployment (palcas_core/common/message_auth.h): advisory arrays without
+  /// its tag are refused. "" = authentication off (any publisher may advise; warned at start).
   std::string auth_key_file;
   /// An applied advisory holds this many steps; then, without a new one, the CAV keeps its
   /// speed. CAVs of an RSU that misses a step's deadline keep their speed at once.

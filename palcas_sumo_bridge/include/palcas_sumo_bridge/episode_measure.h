@@ -2,8 +2,8 @@
 // Measuring an episode from what the bridge publishes: the same code runs live in the node
 // and offline on a recorded bag (metrics_from_bag), so the two agree by construction.
 
-#include <palcas_core/episode_metrics.h>
-#include <palcas_core/outcome_tracker.h>
+#include <palcas_core/metrics/episode_metrics.h>
+#include <palcas_core/metrics/outcome_tracker.h>
 #include <palcas_msgs/VehicleEventArray.h>
 #include <palcas_msgs/VehicleStateArray.h>
 

@@ -2,10 +2,10 @@
 // Conversions between the bridge's plain types (palcas_sim, palcas_core) and palcas_msgs.
 // Free functions in one place; a round-trip test covers them.
 
-#include <palcas_core/advisory_validator.h>
-#include <palcas_core/episode_metrics.h>
-#include <palcas_core/outcome_tracker.h>
-#include <palcas_core/vehicle_event.h>
+#include <palcas_core/metrics/advisory_validator.h>
+#include <palcas_core/metrics/episode_metrics.h>
+#include <palcas_core/metrics/outcome_tracker.h>
+#include <palcas_core/metrics/vehicle_event.h>
 #include <palcas_msgs/Advisory.h>
 #include <palcas_msgs/EpisodeMetrics.h>
 #include <palcas_msgs/VehicleEvent.h>

@@ -2,7 +2,7 @@
 // The run folder of one episode: the generated scenario, manifest.json (what ran: config
 // snapshot and hash, seeds, SUMO version, git commit, command line) and metrics.json.
 
-#include <palcas_core/episode_metrics.h>
+#include <palcas_core/metrics/episode_metrics.h>
 
 #include <cstdint>
 #include <map>

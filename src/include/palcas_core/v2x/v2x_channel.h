@@ -13,7 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "palcas_core/road_snapshot.h"
+#include "palcas_core/common/road_snapshot.h"
 
 namespace palcas::v2x {
 

@@ -1,0 +1,5 @@
+# common tests (test/common/): one gtest per module
+palcas_core_add_gtest(action_test test/common/action_test.cpp)
+palcas_core_add_gtest(rng_test test/common/rng_test.cpp)
+# message authentication: HMAC-SHA256 vectors, tampering, key files
+palcas_core_add_gtest(message_auth_test test/common/message_auth_test.cpp)

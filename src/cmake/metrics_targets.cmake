@@ -1,1 +1,0 @@
-# metrics targets (filled by the metrics area)

@@ -1,0 +1,29 @@
+#pragma once
+// Hyperbolic tangent y = tanh(x), element-wise; bounds the parameter network's output to
+// [-1, 1] before the agent scales it to the acceleration range.
+
+#include "palcas_core/learning/nn/layer.h"
+
+namespace palcas::nn {
+
+/// Tanh activation; no parameters.
+class Tanh : public Layer {
+ public:
+  /// size: features in = out. Throws std::invalid_argument if size < 1.
+  explicit Tanh(Index size);
+
+  std::string typeName() const override { return "Tanh"; }
+  std::string description() const override;
+  Index inputSize() const override { return size_; }
+  Index outputSize() const override { return size_; }
+  const Matrix& forward(const Matrix& input, bool training) override;
+  const Matrix& backward(const Matrix& grad_output, const BackwardOptions& options) override;
+  std::unique_ptr<Layer> clone() const override;
+
+ private:
+  Index size_;
+  bool has_forward_ = false;
+  Matrix output_, grad_input_;
+};
+
+}  // namespace palcas::nn

@@ -1,0 +1,253 @@
+#pragma once
+// One RSU's decisions and learning, without ROS (paper "Design of PALCAS").
+// The palcas_rsu node is a thin shell around RsuController: it converts messages to a
+// RoadSnapshot, decides WHEN to call decide(), publishes the result, and runs the
+// federation exchange. Behaviour, choices and their reasons: src/doc/rsu.md.
+//
+// Conventions: lanes 1 = rightmost (exit) .. L = leftmost, 0 = off the mainline;
+// x = metres along the mainline; SI units; time is an argument, never read inside.
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "palcas_core/common/action.h"
+#include "palcas_core/common/road_snapshot.h"
+#include "palcas_core/learning/model_blob.h"
+#include "palcas_core/learning/pdqn_agent.h"
+#include "palcas_core/learning/pdqn_config.h"
+#include "palcas_core/metrics/vehicle_event.h"
+#include "palcas_core/reward/reward.h"
+#include "palcas_core/rsu/cluster_stats.h"
+#include "palcas_core/state/state_builder.h"
+
+namespace palcas::rsu {
+
+/// Every knob of one RSU controller (config/rsu.yaml, config/reward.yaml, config/learning.yaml).
+struct RsuControllerOptions {
+  std::string rsu_id = "rsu_0";  ///< non-empty; names this RSU in checkpoints and messages
+  int cluster_index = 0;         ///< 0-based, upstream to downstream
+  double x_start_m = 0.0;        ///< zone [x_start_m, x_end_m) along the mainline [m]
+  double x_end_m = 800.0;
+  int num_lanes = 5;  ///< mainline lanes L >= 1; pdqn.state_size must be 40 + L
+  bool train = true;  ///< true: explore, remember, update; false: greedy evaluation only
+  /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
+  /// fractional credit accumulates (0.25 = one step every 4 calls).
+  double gradient_steps_per_decision = 1.0;
+  /// Local gradient steps between federation rounds (paper E = 2500); 0 = never due
+  /// (independent baseline).
+  uint64_t federation_interval_steps = 2500;
+  /// Subtracted from the last reward of a CAV removed by a COLLISION or TELEPORT event
+  /// (>= 0, finite). Default 0: the paper defines no terminal penalty.
+  double collision_penalty = 0.0;
+  // Terminal outcomes (the paper defines none; src/doc/rsu.md "Terminal transitions").
+  // Each is >= 0 and finite; 0 and false are the paper's behaviour.
+  /// Added to the transition that ends on the CAV's own off-ramp (exit taken; terminal).
+  double exit_taken_bonus = 0.0;
+  /// Subtracted from the transition in which a CAV passed its off-ramp without taking it.
+  double exit_missed_penalty = 0.0;
+  /// true: that transition is terminal (the task of reaching the exit ended, failed); the
+  /// CAV's later decisions are new episodes of a through vehicle. false: it goes on.
+  bool exit_missed_terminal = false;
+  /// Subtracted from the transition in which a merging CAV failed (MERGE_FAILED event).
+  double merge_failed_penalty = 0.0;
+  /// true: a transition's reward is the mean of the per-step rewards over the period the
+  /// decision held (every bridge step up to the next decision, fed by observeStep()).
+  /// false (paper): the reward of the one snapshot at the next decision.
+  bool reward_over_period = false;
+  RewardParams reward;  ///< paper reward constants
+  StateScales scales;   ///< state normalisation
+  PdqnConfig pdqn;      ///< agent hyper-parameters (seed included)
+
+  /// Throws std::invalid_argument naming the first bad field ("x_end_m", "pdqn.state_size",
+  /// "reward.rho", ...) and its value.
+  void validate() const;
+};
+
+/// Ids of vehicles that something happened to since the previous decide() call (from
+/// palcas_msgs/VehicleEvent). Ids that this RSU does not know are ignored.
+struct VehicleOutcomes {
+  std::vector<std::string> collided;     ///< COLLISION: removed; terminal with penalty
+  std::vector<std::string> teleported;   ///< TELEPORT: removed; terminal with penalty
+  std::vector<std::string> arrived;      ///< ARRIVED: left at its route's end; terminal
+  std::vector<std::string> exited;       ///< EXIT_OK: on its own off-ramp; terminal
+  std::vector<std::string> exit_missed;  ///< EXIT_MISSED: still on the road
+  std::vector<std::string> merge_failed; ///< MERGE_FAILED: penalised, not terminal
+
+  /// Files `id` under the list of `kind`; DEPARTED, MERGE_OK and MERGE_FAILED are ignored
+  /// (they end nothing). Never throws except std::bad_alloc.
+  void add(metrics::VehicleEventKind kind, const std::string& id);
+  void clear();
+};
+
+/// The advisory for one member CAV.
+struct CavAdvisory {
+  std::string vehicle_id;
+  Decision decision;  ///< action and acceleration parameter [m/s^2]
+};
+
+/// Everything one decide() call produces for the node to publish.
+struct DecisionOutput {
+  uint64_t step = 0;     ///< as passed in
+  double time_s = 0.0;   ///< as passed in [s]
+  uint32_t model_version = 0;
+  std::vector<CavAdvisory> advisories;  ///< one per member, in snapshot order
+  ClusterSummary cluster;               ///< this zone's statistics, for I2I (ClusterState)
+};
+
+/// Counters and figures for the node's status topics.
+struct RsuControllerStats {
+  uint64_t decisions = 0;     ///< decide() calls since construction
+  uint32_t member_count = 0;  ///< members at the last decision
+  /// Advisories per action code (Action order) at the last decision.
+  std::array<uint32_t, ACTION_COUNT> action_counts{};
+  uint32_t transitions_closed = 0;  ///< transitions closed at the last decision (train mode)
+  /// Mean per-CAV reward of the transitions closed at the last decision; NaN when none.
+  double mean_reward = std::numeric_limits<double>::quiet_NaN();
+  /// R_k: sum of the per-CAV rewards of those transitions (paper's sum over CAVs).
+  double sum_reward = 0.0;
+  /// Losses of the last gradient step; NaN before the first one.
+  double q_loss = std::numeric_limits<double>::quiet_NaN();
+  double param_loss = std::numeric_limits<double>::quiet_NaN();
+  double epsilon = 0.0;
+  uint64_t gradient_steps = 0;            ///< agent's total gradient steps
+  uint64_t samples_since_federation = 0;  ///< n_k
+  uint64_t transitions_stored = 0;        ///< total remembered since construction / checkpoint
+  uint64_t pending_dropped = 0;           ///< pending transitions dropped by new episodes
+  uint32_t model_version = 0;
+  uint32_t federation_round = 0;  ///< global models loaded so far
+};
+
+/// A lane change that leaves the mainline lanes (left from lane L; right from lane 1 or from
+/// the acceleration lane, lane 0) becomes KEEP: the bridge would refuse it, and the replay
+/// should hold the action that was executed. Other decisions are returned unchanged.
+Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
+
+/// One RSU k: membership, batched PDQN decisions, transitions, gradient steps, federation
+/// bookkeeping and checkpoints for zone [x_start_m, x_end_m). Deterministic for a seed
+/// (one Eigen thread). Not thread-safe: call from one thread. Movable, not copyable.
+class RsuController {
+ public:
+  /// Validates the options (RsuControllerOptions::validate) and builds the agent.
+  /// Throws std::invalid_argument naming the bad field.
+  explicit RsuController(const RsuControllerOptions& options);
+
+  /// One decision round. `snapshot`: the whole road (num_lanes must equal the options');
+  /// `step`: bridge step; `time_s`: simulation time [s], finite and >= 0; `global`: I2I
+  /// densities [veh/km], NaN = unknown; `outcomes`: events since the previous call.
+  /// Closes the pending transitions (train mode), decides for every member in ONE batched
+  /// act() (impossible lane changes masked to KEEP), runs the due gradient steps (train mode). A step not greater than the previous
+  /// call's starts a new episode (see endEpisode()).
+  /// Throws std::invalid_argument naming the vehicle and field (NaN, lane outside 0..L,
+  /// duplicate id, ...), a wrong num_lanes, or a bad time; the controller is then untouched.
+  /// decide() = advise() then learn(); a node that must answer fast calls advise(),
+  /// publishes, then learn(), so the advisories do not wait for the gradient steps.
+  DecisionOutput decide(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                        const GlobalDensities& global, const VehicleOutcomes& outcomes);
+  /// decide() without the gradient steps (same preconditions and exceptions).
+  DecisionOutput advise(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                        const GlobalDensities& global, const VehicleOutcomes& outcomes);
+  /// The gradient steps due after one decision (train mode; nothing in eval mode).
+  /// Touches only the agent: a node may run it on another thread while it calls
+  /// observeStep(), and must join it before the next advise()/decide() or any other call.
+  void learn();
+  /// A bridge step between two decisions (train mode, reward_over_period): adds every
+  /// pending CAV's reward at this step to its period mean. Never touches the agent.
+  /// Throws std::invalid_argument like advise() on a malformed snapshot (nothing changed).
+  void observeStep(const RoadSnapshot& snapshot);
+
+  /// Drops the pending transitions without storing them (an episode cut by the simulation
+  /// end is not a terminal state) and forgets the previous step.
+  void endEpisode();
+
+  /// True when a member: a CAV with x_m in [x_start_m, x_end_m) on a mainline lane
+  /// (lane >= 1) or on the acceleration lane.
+  bool isMember(const VehicleSnapshot& vehicle) const;
+
+  /// True once federation_interval_steps local gradient steps were made since the last
+  /// loadGlobalModel() (or construction); stays true until the next loadGlobalModel().
+  bool federationDue() const;
+  /// The local model to submit (online networks).
+  ModelBlob exportModel() const { return agent_.exportModel(); }
+  /// n_k: transitions stored since the last loadGlobalModel() (or construction).
+  uint64_t samplesSinceFederation() const { return samples_since_federation_; }
+  /// Imports the global model and starts a new round: clears the due flag and n_k,
+  /// sets the model version, counts the round. Throws std::invalid_argument (local model
+  /// and counters kept) on another layout, a bad checksum, wrong size, non-finite value,
+  /// or a version older than the current one.
+  void loadGlobalModel(const ModelBlob& blob, uint32_t version);
+  /// Loads a model file written by PdqnAgent::saveModel / saveModelBlob (for eval).
+  /// Throws std::runtime_error (model untouched) if the file fails a check. The model
+  /// version is left as it is.
+  void loadPolicy(const std::string& path);
+
+  /// Writes <dir>/agent.ckpt (PdqnAgent checkpoint: networks, optimisers, replay, epsilon,
+  /// RNG) and <dir>/controller.txt (this controller's counters), each atomically (temp
+  /// file + rename); creates `dir` if needed. Pending transitions are not saved.
+  /// Throws std::runtime_error on an I/O error, and (writing nothing) when `dir` already
+  /// holds a checkpoint this controller neither loaded nor wrote last: another process owns
+  /// it, e.g. a newer launch of the same training, and an older one must not overwrite it.
+  void saveCheckpoint(const std::string& dir) const;
+  /// Reads what saveCheckpoint wrote. Throws std::runtime_error (controller untouched) if
+  /// a file is missing, not ours, of another rsu_id or layout, or malformed. On success
+  /// the pending transitions are dropped and the previous step forgotten.
+  void loadCheckpoint(const std::string& dir);
+
+  RsuControllerStats stats() const;
+  const RsuControllerOptions& options() const { return options_; }
+  const PdqnAgent& agent() const { return agent_; }
+  uint32_t modelVersion() const { return model_version_; }
+  uint32_t federationRound() const { return federation_round_; }
+  /// Members whose last decision waits for its outcome (train mode).
+  size_t pendingCount() const { return pending_.size(); }
+
+ private:
+  /// A member's last decision, waiting for its outcome.
+  struct Pending {
+    nn::Vector state;
+    Decision decision;
+    double reward = 0.0;  ///< reward at that observation (for terminal transitions)
+    double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
+    double period_reward_sum = 0.0;   ///< rewards of the steps since (reward_over_period)
+    int period_steps = 0;
+    /// The reward the transition gets: the period mean including `now` when kept.
+    double periodReward(double now, bool over_period) const {
+      return over_period ? (period_reward_sum + now) / (period_steps + 1) : now;
+    }
+    /// Mean reward since the decision, or the decision's own when no step was seen.
+    double lastReward() const {
+      return period_steps > 0 ? period_reward_sum / period_steps : reward;
+    }
+  };
+  struct Observation;  // everything decide() computes before changing any state
+
+  Observation observe(const RoadSnapshot& snapshot, const GlobalDensities& global,
+                      const VehicleOutcomes& outcomes) const;
+  void closePending(const Observation& obs);
+  void runGradientSteps();
+
+  RsuControllerOptions options_;
+  StateBuilder builder_;
+  PdqnAgent agent_;
+  std::map<std::string, Pending> pending_;  // ordered: transitions are stored by id
+  // Vanished without an event: its COLLISION / ARRIVED event may still be on its way
+  // (another topic), so the transition is closed one decision later.
+  std::map<std::string, Pending> limbo_;
+  bool have_last_step_ = false;
+  uint64_t last_step_ = 0;
+  double gradient_credit_ = 0.0;
+  uint64_t samples_since_federation_ = 0;
+  uint64_t grad_steps_at_round_ = 0;
+  uint32_t model_version_ = 0;
+  uint32_t federation_round_ = 0;
+  RsuControllerStats stats_;
+  // The checkpoint this controller continues (loaded or last wrote): saveCheckpoint only
+  // replaces a file with this id (mutable: saving does not change what the controller does).
+  mutable bool checkpoint_owned_ = false;
+  mutable uint64_t checkpoint_seen_id_ = 0;
+};
+
+}  // namespace palcas::rsu
