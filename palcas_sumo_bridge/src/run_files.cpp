@@ -1,6 +1,7 @@
 #include "palcas_sumo_bridge/run_files.h"
 
 #include <nlohmann/json.hpp>
+#include <palcas_core/common/atomic_file.h>
 
 #include <algorithm>
 #include <cmath>
@@ -40,14 +41,7 @@ std::string fingerprint(const std::string& text) {
 }
 
 void writeAtomically(const std::string& path, const json& content) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
-    out << content.dump(2) << "\n";
-    if (!out) throw std::runtime_error("write to '" + tmp + "' failed");
-  }
-  fs::rename(tmp, path);
+  writeFileAtomically(path, content.dump(2) + "\n");
 }
 
 /// A resumed training's episodes.csv written before columns were added at its end: the
@@ -60,13 +54,7 @@ void upgradeHeader(const std::string& csv, const std::string& header) {
   std::stringstream rest;
   rest << in.rdbuf();
   in.close();
-  const std::string tmp = csv + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << header << '\n' << rest.str();
-    if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
-  }
-  fs::rename(tmp, csv);
+  writeFileAtomically(csv, header + "\n" + rest.str());
 }
 
 json twoPoint(const sim::TwoPointSpeed& s) {
@@ -376,13 +364,7 @@ RoadView prepareRvizView(const BridgeOptions& options,
   text << in.rdbuf();
   try {
     const RoadView view = frameRoad(roadExtent(lane_shapes), windowOf(text.str()));
-    const std::string path = options.out_dir + "/palcas.rviz", tmp = path + ".tmp";
-    {
-      std::ofstream out(tmp);
-      out << withView(text.str(), view);
-      if (!out) throw std::runtime_error("cannot write '" + tmp + "'");
-    }
-    fs::rename(tmp, path);
+    writeFileAtomically(options.out_dir + "/palcas.rviz", withView(text.str(), view));
     return view;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error("~rviz_template '" + options.rviz_template + "': " + e.what());

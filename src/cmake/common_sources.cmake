@@ -1,9 +1,10 @@
-# common sources (lib/common/): action codes, the random number generator, the road
-# snapshot every other folder reads, and the HMAC tags that authenticate advisories and
-# model submissions. Includes nothing else of the core.
+# common sources (lib/common/): action codes, the one atomic file write, the random number
+# generator, the road snapshot every other folder reads, and the HMAC tags that authenticate
+# advisories and model submissions. Includes nothing else of the core.
 list(APPEND PALCAS_CORE_SOURCES
   lib/common/action.cpp
   lib/common/rng.cpp
   lib/common/road_snapshot.cpp
   lib/common/message_auth.cpp
+  lib/common/atomic_file.cpp
 )

@@ -3,3 +3,5 @@ palcas_core_add_gtest(action_test test/common/action_test.cpp)
 palcas_core_add_gtest(rng_test test/common/rng_test.cpp)
 # message authentication: HMAC-SHA256 vectors, tampering, key files
 palcas_core_add_gtest(message_auth_test test/common/message_auth_test.cpp)
+# the one atomic file write: replace whole or keep the old file, errors name the file
+palcas_core_add_gtest(atomic_file_test test/common/atomic_file_test.cpp)

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "federation_json.h"
+#include "palcas_core/common/atomic_file.h"
 #include "palcas_core/federation/federation_server.h"
 #include "palcas_core/learning/nn/serialization.h"
 
@@ -23,19 +24,6 @@ constexpr uint64_t STATE_FORMAT_VERSION = 1;
 // written with (a crash between the two renames leaves a detectable mismatch).
 uint64_t valuesChecksum(const ModelBlob& blob) {
   return nn::fnv1a64(blob.values.data(), blob.values.size() * sizeof(float));
-}
-
-// Writes to "<path>.tmp" then rename(2): readers see the old file or the new one, whole.
-void writeAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error(tmp + ": cannot write: " + std::strerror(errno));
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    throw std::runtime_error(path + ": cannot rename " + tmp + ": " + std::strerror(errno));
 }
 
 std::string readText(const std::string& path) {
@@ -83,7 +71,7 @@ void FederationServer::saveCheckpoint(const std::string& dir) const {
       << ",\n  \"failed_aggregations\": " << failed_aggregations_
       << ",\n  \"last_round_s\": " << json::number(last_round_.duration_s)
       << ",\n  \"bytes_in_last_round\": " << last_round_.bytes_in << "\n}\n";
-  writeAtomically(dir + "/" + STATE_FILE, out.str());
+  writeFileAtomically(dir + "/" + STATE_FILE, out.str());
 }
 
 void FederationServer::loadCheckpoint(const std::string& dir) {

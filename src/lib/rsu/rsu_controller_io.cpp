@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "palcas_core/common/atomic_file.h"
 #include "palcas_core/rsu/rsu_controller.h"
 
 namespace palcas::rsu {
@@ -109,21 +110,6 @@ ControllerCounters readCounters(const std::string& path) {
   return c;
 }
 
-void writeAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + reason);
-  }
-}
-
 }  // namespace
 
 void RsuController::loadGlobalModel(const ModelBlob& blob, uint32_t version) {
@@ -173,7 +159,7 @@ void RsuController::saveCheckpoint(const std::string& dir) const {
        << "transitions_stored " << stats_.transitions_stored << "\n"
        << "decisions " << stats_.decisions << "\n"
        << "checkpoint_id " << id << "\n";
-  writeAtomically(counters_path, text.str());
+  writeFileAtomically(counters_path, text.str());
   checkpoint_owned_ = true;
   checkpoint_seen_id_ = id;
 }

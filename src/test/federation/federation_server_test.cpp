@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -44,12 +46,7 @@ std::string tempDir(const std::string& name) {
 
 template <typename E, typename F>
 void expectThrowMentioning(F f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception; expected one mentioning " << needle;
-  } catch (const E& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<E>(f, needle);
 }
 
 }  // namespace

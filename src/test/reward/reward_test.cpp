@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -32,12 +34,8 @@ CavSituation quiet() {
 
 // Expects std::invalid_argument whose message names `key`.
 void expectRejected(const CavSituation& s, const std::string& key) {
-  try {
-    computeReward(s, RewardParams());
-    ADD_FAILURE() << "expected std::invalid_argument naming " << key;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("'" + key + "'"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [&] { computeReward(s, RewardParams()); }, "'" + key + "'");
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -133,12 +135,7 @@ void expectSameDecisions(const DecisionOutput& a, const DecisionOutput& b) {
 
 template <typename F>
 void expectInvalid(F&& f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception; expected one naming '" << needle << "'";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(f, needle);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -32,12 +34,8 @@ std::string idAt(const palcas::Neighbourhood& h, NeighbourSlot s) {
 }
 
 void expectThrowNaming(const RoadSnapshot& snap, const std::string& needle) {
-  try {
-    NeighbourFinder finder(snap);
-    ADD_FAILURE() << "expected std::invalid_argument naming " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { NeighbourFinder finder(snap); },
+                                                            needle);
 }
 
 }  // namespace

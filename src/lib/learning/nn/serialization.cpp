@@ -7,6 +7,7 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "palcas_core/common/atomic_file.h"
 #include "palcas_core/learning/nn/network.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the model format is little-endian");
@@ -97,17 +98,7 @@ void writeModelFile(const std::string& path, const FileContents& contents) {
   w.floats(contents.values.data(), contents.values.size());
   w.str(contents.extra);
   w.u64(fnv1a64(w.bytes().data(), w.bytes().size()));
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(w.bytes().data(), static_cast<std::streamsize>(w.bytes().size()));
-    out.close();
-    if (!out) throw std::runtime_error("cannot write model file " + tmp);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + std::strerror(errno));
-  }
+  writeFileAtomically(path, w.bytes());
 }
 
 FileContents readModelFile(const std::string& path, FileKind expected_kind) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -41,12 +43,8 @@ Network smallNet(uint64_t seed, Index hidden = 3) {
 void expectRefused(const std::string& path, const std::string& needle) {
   Network target = smallNet(99);
   const Vector before = target.getState();
-  try {
-    loadNetwork(target, path);
-    ADD_FAILURE() << "loaded " << path;
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::runtime_error>([&] { loadNetwork(target, path); },
+                                                        needle);
   EXPECT_EQ(target.getState(), before);
 }
 
