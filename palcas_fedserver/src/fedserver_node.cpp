@@ -57,8 +57,8 @@ void FedServerNode::takeStateSizeFromTheRoad() {
                              common::ROAD_LANES_PARAM + " within ~road_wait_s = " +
                              std::to_string(options_.road_wait_s) + " s");
   options_.learning.state_size = StateLayout(road->num_lanes).size();
-  ROS_INFO("palcas fedserver: state size %d (40 + the road's %d lanes)", options_.learning.state_size,
-           road->num_lanes);
+  ROS_INFO("palcas fedserver: state size %d (%d + the road's %d lanes)", options_.learning.state_size,
+           LANE_INDEPENDENT_FEATURE_COUNT, road->num_lanes);
 }
 
 void FedServerNode::initializeModel() {

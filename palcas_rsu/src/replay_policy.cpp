@@ -349,7 +349,7 @@ int run(const Args& args) {
     if (model_states >= 0 && model_states != state_size)
       throw InputError("the model '" + r.model.string() + "' takes a state of " + std::to_string(model_states) +
                        " features, but the recorded road has " + std::to_string(road.num_lanes) +
-                       " lanes: its state has 40 + " + std::to_string(road.num_lanes) + " = " +
+                       " lanes: its state has " + std::to_string(palcas::LANE_INDEPENDENT_FEATURE_COUNT) + " + " + std::to_string(road.num_lanes) + " = " +
                        std::to_string(state_size) + " (a policy trained on another road)");
     r.controller = std::make_unique<RsuController>(r.options.controller);
     try {

@@ -117,24 +117,12 @@ bool FederationServer::checkSubmission(const std::string& rsu_id, uint32_t round
   if (n_k == 0 || n_k > options_.max_samples)
     return refuse(Rejection::kBadSampleCount, "n_k = " + std::to_string(n_k) + " is outside [1, " +
                                                   std::to_string(options_.max_samples) + "]");
-  if (blob.layout_id != g.layout_id)
-    return refuse(Rejection::kLayoutMismatch, "layout '" + blob.layout_id +
-                                                  "' differs from the global model's '" +
-                                                  g.layout_id + "'");
-  if (blob.layout_checksum != g.layout_checksum)
-    return refuse(Rejection::kLayoutMismatch,
-                  "layout checksum " + std::to_string(blob.layout_checksum) +
-                      " differs from the global model's " + std::to_string(g.layout_checksum));
-  if (blob.values.size() != g.values.size())
-    return refuse(Rejection::kWrongValueCount,
-                  std::to_string(blob.values.size()) + " values, the global model has " +
-                      std::to_string(g.values.size()));
-  for (size_t i = 0; i < blob.values.size(); ++i) {
-    if (!std::isfinite(blob.values[i])) {
-      std::ostringstream text;
-      text << "value " << i << " is not finite (" << blob.values[i] << ")";
-      return refuse(Rejection::kNonFinite, text.str());
-    }
+  const BlobCheck check = checkModelBlob(blob, &g, "the global model");
+  switch (check.problem) {
+    case BlobProblem::kNone: break;
+    case BlobProblem::kLayoutMismatch: return refuse(Rejection::kLayoutMismatch, check.detail);
+    case BlobProblem::kWrongValueCount: return refuse(Rejection::kWrongValueCount, check.detail);
+    case BlobProblem::kNonFinite: return refuse(Rejection::kNonFinite, check.detail);
   }
   if (options_.max_update_norm_ratio > 0) {
     double update2 = 0.0, global2 = 0.0;

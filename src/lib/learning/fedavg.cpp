@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "palcas_core/learning/model_blob.h"
 #include "palcas_core/learning/nn/serialization.h"
 
 namespace palcas {
@@ -17,24 +18,8 @@ namespace {
 }
 
 void checkModel(const ModelBlob& m, size_t k, const ModelBlob& first) {
-  const std::string which = "model " + std::to_string(k);
-  if (m.layout_checksum != nn::fnv1a64(m.layout_id))
-    fail(which + " has layout checksum " + std::to_string(m.layout_checksum) +
-         " that does not match its layout id");
-  if (m.layout_id != first.layout_id)
-    fail(which + " has layout '" + m.layout_id + "', model 0 has '" + first.layout_id + "'");
-  if (m.values.size() != first.values.size())
-    fail(which + " has " + std::to_string(m.values.size()) + " values, model 0 has " +
-         std::to_string(first.values.size()));
-  const Eigen::Map<const Eigen::VectorXf> v(m.values.data(), static_cast<Eigen::Index>(m.values.size()));
-  if (v.allFinite()) return;
-  for (size_t i = 0; i < m.values.size(); ++i) {
-    if (!std::isfinite(m.values[i])) {
-      std::ostringstream msg;
-      msg << which << " value " << i << " is not finite (" << m.values[i] << ")";
-      fail(msg.str());
-    }
-  }
+  const BlobCheck check = checkModelBlob(m, &first, "model 0");
+  if (!check.ok()) fail("model " + std::to_string(k) + ": " + check.detail);
 }
 
 }  // namespace

@@ -45,8 +45,8 @@ void softUpdate(nn::Network& target, const nn::Network& online, float tau) {
 }  // namespace
 
 void PdqnAgent::maskInvalidNextActions(const nn::Matrix& next_states, nn::Matrix& q) const {
-  // Ego lane feature = lane / L (0 on the acceleration lane); L = state_size - 40.
-  const int lanes = config_.state_size - 40;
+  // Ego lane feature = lane / L (0 on the acceleration lane).
+  const int lanes = lanesOfStateSize(config_.state_size);
   const nn::Index lane_row = static_cast<nn::Index>(EgoFeature::kLane);
   constexpr float BLOCKED = -std::numeric_limits<float>::infinity();
   for (nn::Index j = 0; j < next_states.cols(); ++j) {

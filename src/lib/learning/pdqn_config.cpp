@@ -3,12 +3,15 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+
+#include "palcas_core/state/state_layout.h"
 
 namespace palcas {
 
 namespace {
 template <typename T>
-void require(bool ok, const char* field, T value, const char* rule) {
+void require(bool ok, const char* field, T value, const std::string& rule) {
   if (ok) return;
   std::ostringstream msg;
   msg << "PdqnConfig." << field << " = " << value << " is invalid: " << rule;
@@ -48,8 +51,9 @@ void PdqnConfig::validate() const {
           "must be in [0, 1]");
   require(epsilon_linear_rounds >= 0 && std::isfinite(epsilon_linear_rounds),
           "epsilon_linear_rounds", epsilon_linear_rounds, "must be finite and >= 0");
-  require(!td_target_valid_actions || state_size > 40, "state_size", state_size,
-          "must be 40 + L (L >= 1) with td_target_valid_actions");
+  require(!td_target_valid_actions || lanesOfStateSize(state_size) >= 1, "state_size", state_size,
+          "must be " + std::to_string(LANE_INDEPENDENT_FEATURE_COUNT) +
+              " + L (L >= 1) with td_target_valid_actions");
   require(accel_noise_std_mps2 >= 0 && std::isfinite(accel_noise_std_mps2),
           "accel_noise_std_mps2", accel_noise_std_mps2, "must be >= 0");
 }

@@ -60,7 +60,8 @@ void RsuControllerOptions::validate() const {
   nested("pdqn", [&] { pdqn.validate(); });
   const int needed = StateLayout(num_lanes).size();
   require(pdqn.state_size == needed, "pdqn.state_size", pdqn.state_size,
-          "must be 40 + num_lanes = " + std::to_string(needed));
+          "must be " + std::to_string(LANE_INDEPENDENT_FEATURE_COUNT) +
+              " + num_lanes = " + std::to_string(needed));
 }
 
 void VehicleOutcomes::add(metrics::VehicleEventKind kind, const std::string& id) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cfloat>
 #include <limits>
 
@@ -19,12 +21,8 @@ ModelBlob blob(std::vector<float> values, const std::string& layout = "L") {
 // Expects fedAverage to throw std::invalid_argument mentioning `needle`.
 void expectRejected(const std::vector<ModelBlob>& models, const std::vector<uint64_t>& n,
                     const std::string& needle, uint64_t max = FEDAVG_MAX_SAMPLES_DEFAULT) {
-  try {
-    fedAverage(models, n, max);
-    ADD_FAILURE() << "accepted; expected an error about " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { fedAverage(models, n, max); },
+                                                            needle);
 }
 
 }  // namespace
@@ -56,15 +54,15 @@ TEST(FedAvg, RejectsBadInputNamingIt) {
   const ModelBlob a = blob({1, 2}), b = blob({3, 4});
   expectRejected({}, {}, "no models");
   expectRejected({a, b}, {1}, "2 models but 1 sample counts");
-  expectRejected({a, blob({1, 2}, "other")}, {1, 1}, "model 1 has layout 'other'");
+  expectRejected({a, blob({1, 2}, "other")}, {1, 1}, "model 1: layout 'other' differs from model 0's");
   ModelBlob bad_checksum = b;
   bad_checksum.layout_checksum ^= 1;
-  expectRejected({a, bad_checksum}, {1, 1}, "model 1 has layout checksum");
-  expectRejected({a, blob({1, 2, 3})}, {1, 1}, "model 1 has 3 values, model 0 has 2");
+  expectRejected({a, bad_checksum}, {1, 1}, "model 1: layout checksum");
+  expectRejected({a, blob({1, 2, 3})}, {1, 1}, "model 1: 3 values, model 0 has 2");
   expectRejected({a, blob({1, std::numeric_limits<float>::quiet_NaN()})}, {1, 1},
-                 "model 1 value 1 is not finite (nan)");
+                 "model 1: value 1 is not finite (nan)");
   expectRejected({blob({std::numeric_limits<float>::infinity(), 0}), b}, {1, 1},
-                 "model 0 value 0 is not finite (inf)");
+                 "model 0: value 0 is not finite (inf)");
   expectRejected({a, b}, {1, 0}, "model 1 has sample count 0");
   expectRejected({a, b}, {2000000000ULL, 1}, "model 0 has sample count 2000000000");
   expectRejected({a, b}, {11, 1}, "plausible maximum 10", 10);

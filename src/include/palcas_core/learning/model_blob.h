@@ -16,8 +16,24 @@ struct ModelBlob {
   std::vector<float> values;
 };
 
-/// Throws std::invalid_argument naming the problem if the checksum does not match the
-/// layout id or a value is not finite (index and value in the message).
+/// What is wrong with a model blob; the one check behind the federation server's refusals,
+/// FedAvg's and a model's import.
+enum class BlobProblem { kNone, kLayoutMismatch, kWrongValueCount, kNonFinite };
+
+struct BlobCheck {
+  BlobProblem problem = BlobProblem::kNone;
+  std::string detail;  ///< names the problem: layout ids, value counts, the bad value's index
+  bool ok() const { return problem == BlobProblem::kNone; }
+};
+
+/// Checks, in this order: the layout id against `reference`'s (when given), the checksum
+/// against the blob's own layout id, the value count against `reference`'s, every value
+/// finite. `reference_name` names the reference in the detail ("the global model").
+BlobCheck checkModelBlob(const ModelBlob& blob, const ModelBlob* reference = nullptr,
+                         const std::string& reference_name = "the reference model");
+
+/// Throws std::invalid_argument "model blob: <detail>" if checkModelBlob(blob) finds a
+/// problem.
 void validateModelBlob(const ModelBlob& blob);
 
 /// Writes the blob as a model file (kind 1, atomically). Throws std::runtime_error.

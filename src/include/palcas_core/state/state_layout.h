@@ -37,6 +37,15 @@ constexpr int NEIGHBOUR_FEATURE_COUNT = 5;
 enum class GlobalFeature : int { kUpstream = 0, kOwn = 1, kDownstream = 2 };
 constexpr int GLOBAL_FEATURE_COUNT = 3;
 
+/// Features whose number does not depend on the road: ego, neighbours, the cluster's mean
+/// speed and the global densities (40). A road of L lanes adds L lane densities.
+constexpr int LANE_INDEPENDENT_FEATURE_COUNT =
+    EGO_FEATURE_COUNT + NEIGHBOUR_SLOT_COUNT * NEIGHBOUR_FEATURE_COUNT + 1 + GLOBAL_FEATURE_COUNT;
+static_assert(LANE_INDEPENDENT_FEATURE_COUNT == 40, "the paper's state is 40 + L features");
+
+/// Lanes of the road a state of `state_size` features was built for (state_size - 40).
+constexpr int lanesOfStateSize(int state_size) { return state_size - LANE_INDEPENDENT_FEATURE_COUNT; }
+
 /// Indices for the paper's five-lane road; StateLayout(5) agrees (tested).
 // clang-format off
 namespace state5 {
