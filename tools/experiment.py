@@ -113,7 +113,7 @@ def settings_from_args(a):
     for arm in arms:
         if arm not in LEARNING_ARMS:
             continue
-        policy = policies.get(arm, str(ROOT / "config" / "policies" / arm))
+        policy = policies.get(arm, str(ROOT / "policies" / arm))
         if not (pathlib.Path(policy) / "checkpoints").is_dir() or \
                 not (pathlib.Path(policy) / "train.json").exists():
             raise UsageError(f"arm '{arm}': no trained policy at {policy} (train it with "

@@ -4,7 +4,7 @@ episodes.csv): no simulation is rerun. Every figure is a PNG with the CSV behind
 
 usage: run_figures.py RUN_DIR --out DIR
   RUN_DIR holds one folder per arm (<arm>/trajectories.csv ...), as ./palcas run writes it.
-  Learning curves come from each learning arm's training record (config/policies/<arm>/ or
+  Learning curves come from each learning arm's training record (policies/<arm>/ or
   the policy a run names in its metrics.json).
 
 Figures:

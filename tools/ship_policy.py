@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Copies what a user needs of a ./palcas train folder into config/policies/<arm>/: the
+"""Copies what a user needs of a ./palcas train folder into policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
 usage: ship_policy.py [--rsu-models] [--default-from RSU] [--bridge-as-trained | --run-with-bridge FILE] TRAIN_DIR DEST_DIR

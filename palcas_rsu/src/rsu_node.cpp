@@ -29,12 +29,12 @@ void requireEvalWeights(const RsuNodeOptions& o) {
   if (o.policy_dir.empty())
     throw std::runtime_error(
         "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR (a training's "
-        "checkpoints/ folder; system.launch's default 'shipped' is config/policies/<arm>/checkpoints; "
+        "checkpoints/ folder; system.launch's default 'shipped' is policies/<arm>/checkpoints; "
         "./palcas train makes new ones), or policy_dir:=random to evaluate an untrained network on "
         "purpose. Only mode train starts from random weights");
   if (!fs::is_directory(o.policy_dir))
     throw std::runtime_error("policy_dir '" + o.policy_dir + "' is not a folder (eval needs a training's "
-                             "checkpoints/ folder, e.g. config/policies/palcas/checkpoints)");
+                             "checkpoints/ folder, e.g. policies/palcas/checkpoints)");
 }
 
 /// The node's options with what they leave to the bridge's road filled in from it (the

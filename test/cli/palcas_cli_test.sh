@@ -83,8 +83,8 @@ check run_scenario_wrong_state "its state has 43 features"  run --out "$OUT" --s
 # A policy folder whose bridge.yaml is not a mapping of bridge parameters.
 BAD_BRIDGE="$WORK/bad_bridge_policy"
 mkdir -p "$BAD_BRIDGE"
-cp -r "$ROOT/config/policies/palcas/checkpoints" "$ROOT/config/policies/palcas/train.json" \
-  "$ROOT/config/policies/palcas/learning_schedule.yaml" "$BAD_BRIDGE/"
+cp -r "$ROOT/policies/palcas/checkpoints" "$ROOT/policies/palcas/train.json" \
+  "$ROOT/policies/palcas/learning_schedule.yaml" "$BAD_BRIDGE/"
 printf -- '- not a mapping\n' >"$BAD_BRIDGE/bridge.yaml"
 check run_policy_bridge_not_a_mapping "its bridge.yaml is not a YAML mapping" run --out "$OUT" --policy "$BAD_BRIDGE"
 check train_bridge_params_missing "--bridge-params '/nonexistent'" train --out "$OUT" --bridge-params /nonexistent
@@ -98,16 +98,16 @@ check experiment_demand_text   "--demands: 'many' is not valid" experiment --out
 # replay: a missing bag or policy, a bad value, --rate without --rviz (the bag's content is
 # checked by replay_policy itself: test/launch/policy_replay.test).
 ANY_FILE="$ROOT/README.md"
-check replay_without_bag       "no bag given"                replay --policy "$ROOT/config/policies/palcas"
-check replay_bag_missing       "bag '/nonexistent.bag': no such file" replay /nonexistent.bag --policy "$ROOT/config/policies/palcas"
+check replay_without_bag       "no bag given"                replay --policy "$ROOT/policies/palcas"
+check replay_bag_missing       "bag '/nonexistent.bag': no such file" replay /nonexistent.bag --policy "$ROOT/policies/palcas"
 check replay_without_policy    "--policy DIR is required"    replay "$ANY_FILE"
 check replay_policy_missing    "--policy '/nonexistent'"     replay "$ANY_FILE" --policy /nonexistent
-check replay_tolerance_text    "--accel-tolerance 'tight'"   replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --accel-tolerance tight
-check replay_learning_missing  "--learning '/nonexistent'"   replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --learning /nonexistent
+check replay_tolerance_text    "--accel-tolerance 'tight'"   replay "$ANY_FILE" --policy "$ROOT/policies/palcas" --accel-tolerance tight
+check replay_learning_missing  "--learning '/nonexistent'"   replay "$ANY_FILE" --policy "$ROOT/policies/palcas" --learning /nonexistent
 check replay_unknown_option    "replay: unknown option '--bogus'" replay "$ANY_FILE" --bogus
 check replay_rate_zero         "--rate '0'"                  replay "$ANY_FILE" --rviz --rate 0
-check replay_rate_without_rviz "--rate goes with --rviz"     replay "$ANY_FILE" --policy "$ROOT/config/policies/palcas" --rate 2
-check replay_rviz_with_policy  "it takes only --rate"        replay "$ANY_FILE" --rviz --policy "$ROOT/config/policies/palcas"
+check replay_rate_without_rviz "--rate goes with --rviz"     replay "$ANY_FILE" --policy "$ROOT/policies/palcas" --rate 2
+check replay_rviz_with_policy  "it takes only --rate"        replay "$ANY_FILE" --rviz --policy "$ROOT/policies/palcas"
 
 # --resume takes road, PR, seed and duration from the training record and refuses a flag
 # that contradicts it (a fake record: these checks stop before anything is built or run).

@@ -20,13 +20,13 @@ sys.path.insert(0, str(ROOT / "test" / "tools"))
 from junit_runner import run_as_junit  # noqa: E402
 
 TOP = ("config/", "launch/", "tools/", "test/", "src/", "docs/", "palcas_msgs/", "palcas_rsu/",
-       "palcas_fedserver/", "palcas_sumo_bridge/", "palcas_common/")
+       "palcas_fedserver/", "palcas_sumo_bridge/", "palcas_common/", "policies/")
 EXT = re.compile(r"\.(md|yaml|yml|launch|test|py|sh|cpp|h|msg|srv|rviz|xml|cmake|txt|palcas|csv|json|png)$")
 GENERATED = ("build/", "devel/", "results/", "/tmp/", "install/", "~", "figures/", "out_dir/", "dir/")
 PLACEHOLDER = re.compile(r"[<>*${}…]|\.\.\.|\bDIR\b|\bFILE\b|\bBAG\b")
 # ROS package names whose folder has another name.
 PACKAGE_DIRS = {"palcas_config/": "config/", "palcas_tests/": "test/", "palcas_launch/": "launch/",
-                "palcas_core/": "src/"}
+                "palcas_core/": "src/", "palcas_policies/": "policies/"}
 
 
 def tracked():

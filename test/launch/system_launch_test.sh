@@ -79,16 +79,16 @@ names+=(demand_reaches_the_bridge); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   demand_reaches_the_bridge"; else echo "FAIL demand_reaches_the_bridge: $why"; fi
 
 # No arguments evaluates the shipped policy, under its own bridge.yaml; so does every learning
-# arm that ships one (the launch file's list of them agrees with config/policies/). An
+# arm that ships one (the launch file's list of them agrees with policies/). An
 # evaluation with no weights is refused; training starts from random weights.
 why=""
 for arm in palcas palcas_assist centralized independent no_priority; do
   rsu=rsu_0; [ "$arm" != centralized ] || rsu=central
   params="$(roslaunch --dump-params palcas_launch system.launch arm:="$arm" out_dir:=/tmp/unused 2>&1)"
-  grep -q "^/$rsu/rsu/policy_dir: $ROOT/config/policies/$arm/checkpoints\$" <<<"$params" ||
-    why="$why $arm does not evaluate config/policies/$arm/checkpoints;"
-  expected=0.0; [ ! -f "$ROOT/config/policies/$arm/bridge.yaml" ] ||
-    expected="$(sed -n 's/^lane_change_max_accel_mps2: *//p' "$ROOT/config/policies/$arm/bridge.yaml")"
+  grep -q "^/$rsu/rsu/policy_dir: $ROOT/policies/$arm/checkpoints\$" <<<"$params" ||
+    why="$why $arm does not evaluate policies/$arm/checkpoints;"
+  expected=0.0; [ ! -f "$ROOT/policies/$arm/bridge.yaml" ] ||
+    expected="$(sed -n 's/^lane_change_max_accel_mps2: *//p' "$ROOT/policies/$arm/bridge.yaml")"
   grep -q "^/palcas_sumo_bridge/lane_change_max_accel_mps2: ${expected}\$" <<<"$params" ||
     why="$why $arm does not run under its shipped bridge.yaml (lane_change_max_accel_mps2 $expected);"
 done

@@ -189,7 +189,7 @@ class PolicyReplayTest(unittest.TestCase):
         self.assertIn("holds no model for rsu_0", r.stdout)
 
         # The shipped palcas policy learnt the 5-lane paper road: 45 features, tiny has 3 lanes.
-        r = replay(self.bag, "--policy", ROOT + "/config/policies/palcas")
+        r = replay(self.bag, "--policy", ROOT + "/policies/palcas")
         self.assertEqual(r.returncode, 1, r.stdout)
         self.assertIn("takes a state of 45 features", r.stdout)
         self.assertIn("40 + 3 = 43", r.stdout)

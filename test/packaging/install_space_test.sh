@@ -22,7 +22,7 @@ why=""
 (cd "$ROOT" && cmake -DCMAKE_INSTALL_PREFIX="$ROOT/install" "$ROOT/build") >/dev/null 2>&1
 [ -n "$why" ] || [ -f "$INSTALL/setup.bash" ] || why="no $INSTALL/setup.bash"
 for f in share/palcas_launch/system.launch share/palcas_config/bridge.yaml \
-         share/palcas_config/policies/palcas/checkpoints/rsu_0/model.palcas lib/palcas_sumo_bridge/bridge_node \
+         share/palcas_policies/palcas/checkpoints/rsu_0/model.palcas lib/palcas_sumo_bridge/bridge_node \
          lib/palcas_rsu/rsu_node lib/palcas_fedserver/fedserver_node \
          include/palcas_core/rsu/rsu_controller.h include/palcas_core/learning/nn/network.h; do
   [ -n "$why" ] || [ -e "$INSTALL/$f" ] || why="the install space lacks $f"
@@ -47,7 +47,7 @@ result keep_runs_from_the_install_space "$why"
 why=""
 episode palcas duration:=30 || true
 if [ ! -f "$WORK/palcas/metrics.json" ]; then why="the shipped policy wrote no metrics.json: $(grep -m3 -i 'error\|fatal' "$WORK/palcas.log" | tr '\n' ' ')"
-elif ! grep -q "evaluating policy $INSTALL/share/palcas_config/policies/palcas/checkpoints" "$WORK/palcas.log"; then
+elif ! grep -q "evaluating policy $INSTALL/share/palcas_policies/palcas/checkpoints" "$WORK/palcas.log"; then
   why="the RSUs did not load the installed shipped policy: $(grep -m2 'evaluating policy' "$WORK/palcas.log" | tr '\n' ' ')"
 fi
 result shipped_policy_runs_from_the_install_space "$why"

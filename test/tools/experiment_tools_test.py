@@ -422,7 +422,7 @@ class FiguresTest(unittest.TestCase):
         self.assertAlmostEqual(float(rows["rsu_1"]["p99_ms"]), 2 * 99.01, places=2)
 
     def test_learning_curves_of_every_arm(self):
-        pol = ROOT / "config" / "policies" / "palcas"
+        pol = ROOT / "policies" / "palcas"
         self.assertTrue(run_figures.learning_curves({"palcas": pol, "copy": pol}, str(self.out / "lc")))
         rows = self.assertFigure("lc")
         n = len(read_csv(pol / "episodes.csv"))
