@@ -38,6 +38,13 @@ result recording_has_bags_and_view "$why"
 cat >"$WORK/inside.sh" <<'INSIDE'
 set -u
 ROOT="$1" WORK="$2" SHOT="$3"
+# rviz under a bare X server (no window manager) once drew the road at half its framed width,
+# centred on column 345 as if its drawing area were 690 px wide, in every screenshot of that
+# start (a loaded CI box; not reproduced since): a second start of the replay gets one more
+# chance, and the log says so.
+status=1
+for attempt in 1 2; do
+[ "$attempt" -eq 1 ] || { echo "attempt 1 failed: $(cat "$WORK/check.txt")"; cp "$SHOT" "$SHOT.attempt1.png"; }
 PALCAS_NO_BUILD=1 "$ROOT/palcas" replay "$WORK/run/episode.bag" --rviz --rate 1 >"$WORK/replay.log" 2>&1 &
 replay=$!
 status=1
@@ -58,9 +65,11 @@ sys.exit(0 if asphalt >= 20000 else 1)
 PY
   [ "$status" -ne 0 ] || break
 done
-cat "$WORK/check.txt"
 kill -INT "$replay" 2>/dev/null
 wait "$replay"
+[ "$status" -ne 0 ] || break
+done
+cat "$WORK/check.txt"
 exit "$status"
 INSIDE
 xvfb-run -a -s "-screen 0 1400x900x24" bash "$WORK/inside.sh" "$ROOT" "$WORK" "$shot" >"$WORK/inside.log" 2>&1
