@@ -79,8 +79,7 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   advisories_pub_ = nh_.advertise<palcas_msgs::AdvisoryArray>(ADVISORIES_TOPIC, 10);
   cluster_pub_ = nh_.advertise<palcas_msgs::ClusterState>(CLUSTER_STATES_TOPIC, 10);
   status_pub_ = nh_.advertise<palcas_msgs::RsuStatus>(RSU_STATUS_TOPIC, 10);
-  // Room for the steps between two decisions and more: the bridge waits only for decisions.
-  states_sub_ = nh_.subscribe(VEHICLE_STATES_TOPIC, 1000, &RsuNode::onStates, this,
+  states_sub_ = nh_.subscribe(VEHICLE_STATES_TOPIC, 10, &RsuNode::onStates, this,
                               ros::TransportHints().tcpNoDelay());
   events_sub_ = nh_.subscribe(VEHICLE_EVENTS_TOPIC, 100, &RsuNode::onEvents, this,
                               ros::TransportHints().tcpNoDelay());
@@ -192,15 +191,9 @@ void RsuNode::registerWithBridge() {
     ros::WallDuration(0.02).sleep();
   palcas_msgs::RegisterRsu srv;
   srv.request.rsu_id = options_.controller.rsu_id;
-  // Answering only decision steps spares the bridge a round trip on the steps between them
-  // (the states still come every step, in order, and are observed).
-  srv.request.answer_period_steps = static_cast<std::uint32_t>(options_.decision_period_steps);
-  if (!client.call(srv) || !srv.response.accepted) {
+  if (!client.call(srv) || !srv.response.accepted)
     ROS_WARN("%s: registration refused: %s", options_.controller.rsu_id.c_str(),
              srv.response.reason.c_str());
-    return;
-  }
-  answer_decision_steps_only_ = true;
 }
 
 void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) { addOutcomes(*msg, outcomes_); }
@@ -255,8 +248,7 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     decide(*msg, received);
     return;
   }
-  // Unregistered, the bridge does not know our period and waits for every step.
-  if (!answer_decision_steps_only_) answerEmpty(*msg, received);
+  answerEmpty(*msg, received);
   const bool observe = options_.controller.train && options_.controller.reward_over_period;
   if (observe || uplink_) {
     try {
@@ -330,10 +322,8 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
   }
   for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
-  // The cluster state first: the peers then have it before the bridge, released by our
-  // answer, runs the steps to the next decision.
-  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
   publishAdvisories(out);
+  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
   if (!options_.learner_thread)
     controller_->learn();  // after publishing: the bridge need not wait for gradient steps
 

@@ -105,12 +105,10 @@ void BridgeNode::advertise() {
 bool BridgeNode::onRegister(palcas_msgs::RegisterRsu::Request& req,
                             palcas_msgs::RegisterRsu::Response& res) {
   std::string reason;
-  res.accepted = lockstep_->registerRsu(req.rsu_id, &reason, req.answer_period_steps);
+  res.accepted = lockstep_->registerRsu(req.rsu_id, &reason);
   res.reason = reason;
   res.next_step = session_->stepCount();
-  if (res.accepted)
-    ROS_INFO("palcas bridge: RSU '%s' registered; it answers every %u step(s)", req.rsu_id.c_str(),
-             std::max<std::uint32_t>(req.answer_period_steps, 1));
+  if (res.accepted) ROS_INFO("palcas bridge: RSU '%s' registered", req.rsu_id.c_str());
   else ROS_WARN("palcas bridge: refused registration: %s", reason.c_str());
   return true;
 }

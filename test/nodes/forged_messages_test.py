@@ -78,7 +78,7 @@ class ForgedMessagesTest(unittest.TestCase):
         end = time.monotonic() + WALL_TIMEOUT_S
         while cls.pub.get_num_connections() < 1 and time.monotonic() < end:
             time.sleep(0.01)
-        reply = rospy.ServiceProxy("/register_rsu", RegisterRsu)(rsu_id=RSU)
+        reply = rospy.ServiceProxy("/register_rsu", RegisterRsu)(RSU)
         assert reply.accepted, reply.reason
 
     @classmethod

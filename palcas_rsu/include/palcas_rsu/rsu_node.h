@@ -98,7 +98,6 @@ class RsuNode {
   /// This zone's density at the previous decision: the "own" global density (veh/km).
   double last_own_density_ = std::numeric_limits<double>::quiet_NaN();
   bool first_state_ = true;
-  bool answer_decision_steps_only_ = false;  ///< registered with the bridge at our decision period
   diagnostic_updater::Updater diagnostics_;
   palcas_msgs::RsuStatus last_status_;  ///< of the last decision, for the diagnostics
   RecentTimes recent_decision_ms_{1000};
