@@ -476,10 +476,7 @@ void BridgeNode::runEpisode(int episode) {
   StepTimer timer;
   recorder_.reset();
   if (options_.trajectory_period_steps > 0) {
-    const bool several = options_.episodes > 1 || options_.first_episode > 0;
-    recorder_ = std::make_unique<sim::RunRecorder>(
-        several ? options_.out_dir + "/episode_" + std::to_string(episode) : options_.out_dir,
-        options_.trajectory_period_steps);
+    recorder_ = std::make_unique<sim::RunRecorder>(episodeDir(options_, episode), options_.trajectory_period_steps);
   }
   publishStep();
   while (ros::ok() && session_->timeS() < duration_s - 1e-9) {

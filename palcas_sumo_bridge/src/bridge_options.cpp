@@ -2,6 +2,7 @@
 
 #include <palcas_common/param_reader.h>
 #include <palcas_common/v2x_params.h>
+#include <palcas_sim/sumo_outputs.h>
 
 #include <cmath>
 #include <map>
@@ -93,6 +94,9 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.git_commit = p.get<std::string>("git_commit", "");
   o.gui = p.get<bool>("gui", o.gui);
   o.sumo_warnings = p.get<bool>("sumo_warnings", o.sumo_warnings);
+  o.sumo_outputs = p.get<std::vector<std::string>>("sumo_outputs", o.sumo_outputs);
+  o.sumo_fcd_period_s = p.number("sumo_fcd_period_s", o.sumo_fcd_period_s, 0.0, 3600.0);
+  sim::sumoOutputArgs(o.sumo_outputs, o.out_dir, o.sumo_fcd_period_s);  // refuses unknown names now, not mid-run
   o.session.advisory_control = p.get<bool>("advisory_control", o.session.advisory_control);
   o.session.cav_speed_mode = p.integer("cav_speed_mode", o.session.cav_speed_mode, 0, 127);
   o.session.cav_lane_change_mode =

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 #include <palcas_core/common/atomic_file.h>
+#include <palcas_sim/sumo_outputs.h>
 
 #include <algorithm>
 #include <cmath>
@@ -121,6 +122,8 @@ json bridgeJson(const BridgeOptions& o) {
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
           {"cav_max_decel_mps2", o.session.cav_max_decel_mps2},
           {"remove_collided", o.session.remove_collided},
+          {"sumo_outputs", o.sumo_outputs},
+          {"sumo_fcd_period_s", o.sumo_fcd_period_s},
           {"expected_rsus", o.expected_rsus},
           {"lockstep_deadline_s", o.lockstep_deadline_s},
           {"lost_after_missed_steps", o.lost_after_missed_steps},
@@ -203,6 +206,11 @@ MeasureRules readMeasureRules(const std::string& manifest_path) {
   return rules;
 }
 
+std::string episodeDir(const BridgeOptions& o, int episode) {
+  const bool several = o.episodes > 1 || o.first_episode > 0;
+  return several ? o.out_dir + "/episode_" + std::to_string(episode) : o.out_dir;
+}
+
 sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg,
                                       int episode) {
   sim::SessionOptions s = o.session;
@@ -216,6 +224,12 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   else s.sumo_args.insert(s.sumo_args.end(), {"--no-warnings", "true"});
   s.sumo_binary = o.gui ? "sumo-gui" : "sumo";
   if (o.gui) s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", "true"});
+  if (!o.sumo_outputs.empty()) {
+    const std::string dir = episodeDir(o, episode);
+    fs::create_directories(dir);
+    const auto outputs = sim::sumoOutputArgs(o.sumo_outputs, dir, o.sumo_fcd_period_s);
+    s.sumo_args.insert(s.sumo_args.end(), outputs.begin(), outputs.end());
+  }
   return s;
 }
 
@@ -323,8 +337,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"episodes", o.episodes},
               {"step_timing", timing}};
   writeAtomically(o.out_dir + "/metrics.json", out);
-  if (o.episodes > 1 || o.first_episode > 0) {  // several episodes: each keeps its own file
-    const std::string dir = o.out_dir + "/episode_" + std::to_string(episode);
+  if (const std::string dir = episodeDir(o, episode); dir != o.out_dir) {  // each episode keeps its own file
     fs::create_directories(dir);
     writeAtomically(dir + "/metrics.json", out);
   }

@@ -27,6 +27,11 @@ struct BridgeOptions {
   // SUMO.
   bool gui = false;                ///< true: external sumo-gui over libtraci
   bool sumo_warnings = false;      ///< true: SUMO's warnings on the console and in <out_dir>/sumo.log
+  /// SUMO's own output files by name (palcas_sim/sumo_outputs.h: fcd, tripinfo, ssm,
+  /// lanechange, collision, summary, statistic), written into the run folder (episode_<k>/
+  /// when several episodes). Empty = none.
+  std::vector<std::string> sumo_outputs;
+  double sumo_fcd_period_s = 1.0;  ///< FCD sampling period [s]; 0 = every step
   sim::SessionOptions session;
   // Lockstep with the RSUs.
   std::vector<std::string> expected_rsus;  ///< empty = no RSUs (SUMO-native)

@@ -60,7 +60,12 @@ struct RunSummary {
 /// @return the .sumocfg path. @throws std::exception naming what failed.
 std::string prepareScenario(const BridgeOptions& options);
 
-/// SUMO session options for a generated scenario; episode k runs with SUMO seed + k.
+/// Where episode k's own files go: the run folder, or <out_dir>/episode_<k> when the run has
+/// several episodes (or continues a training), so each keeps its own.
+std::string episodeDir(const BridgeOptions& options, int episode);
+
+/// SUMO session options for a generated scenario; episode k runs with SUMO seed + k and
+/// writes the SUMO outputs named in options.sumo_outputs into episodeDir (created here).
 sim::SessionOptions sessionOptionsFor(const BridgeOptions& options, const std::string& sumocfg,
                                       int episode = 0);
 
