@@ -117,6 +117,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"guard_busy_window_s", o.session.guard_busy_window_s},
           {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
           {"guard_busy_handback", o.session.guard_busy_handback},
+          {"guard_insertion_edge", o.session.guard_insertion_edge},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
@@ -255,7 +256,9 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"handback", o.session.guard_busy_handback},
           {"handbacks", g.handbacks},
           {"handback_cav_s", dt * g.handback_steps},
-          {"handback_advice_dropped", g.handback_advice_dropped}};
+          {"handback_advice_dropped", g.handback_advice_dropped},
+          {"insertion_edge", o.session.guard_insertion_edge},
+          {"lane_changes_insertion_refused", g.lane_changes_insertion_refused}};
 }
 
 // The advisories' way through the V2X channel (all zero but sent/delivered when it is off).

@@ -172,11 +172,16 @@ void SumoSession::readNetwork() {
       main_lanes = std::max(main_lanes, e.lane_count);
   }
   road_ = std::make_unique<RoadLayout>(edges, main_lanes, options_.cluster_length_m);
-  double end_x = -INF;
+  double end_x = -INF, start_x = INF;
   for (const EdgeInfo& e : edges) {
-    if (e.id.compare(0, 5, "main_") == 0 && e.x_end_m > end_x) {
+    if (e.id.compare(0, 5, "main_") != 0) continue;
+    if (e.x_end_m > end_x) {
       end_x = e.x_end_m;
       end_edge_ = e.id;
+    }
+    if (e.x_start_m < start_x) {
+      start_x = e.x_start_m;
+      insertion_edge_ = e.id;
     }
   }
   // The mainline edge feeding an off-ramp: the one whose end is where the ramp starts.
@@ -630,6 +635,12 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
                               (action == LANE_LEFT && v.on_accel_lane);
     const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
     const bool busy = zoneBusy(zoneOf(v));
+    if (options_.guard_insertion_edge && v.edge == insertion_edge_ && v.lane_change_target == 0) {
+      // Where SUMO inserts vehicles: a sideways move there meets vehicles inserted into it.
+      ++guard_.lane_changes_insertion_refused;
+      holdOwnDriving(v);
+      return;
+    }
     if (!serves_route && v.lane_change_target == 0 && (cooling || busy)) {
       // Weaving for no need of its own route: moments after its last change, or where the
       // road is busy.

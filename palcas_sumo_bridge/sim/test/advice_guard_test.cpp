@@ -57,6 +57,7 @@ TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
   options.guard_busy_leave_share = 0.5;
   options.guard_busy_window_s = 1.0;
   options.guard_busy_handback = false;  // busy zones only refuse weaving (busy_handback_test)
+  options.guard_insertion_edge = false;  // its own test: insertion_guard_test
   SumoSession session(options);
 
   // 1. Braking advice stops at the floor: -1.47 m/s^2 held for 12 s would take a CAV from

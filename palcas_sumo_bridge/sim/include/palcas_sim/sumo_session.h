@@ -99,6 +99,13 @@ struct SessionOptions {
   /// advice alone cannot match there. In assist mode it only drops their advice (they drive
   /// themselves already). false: a busy zone only refuses weaving (guard_busy_speed_share).
   bool guard_busy_handback = true;
+  /// The advice guard where traffic is inserted: no advised lane change is carried out on the
+  /// mainline edge where SUMO inserts the mainline's vehicles (the warm-up edge); the CAV keeps
+  /// its lane and drives itself, as under KEEP. SUMO 1.15 inserts a vehicle (departPos
+  /// random_free, departSpeed max) beside or just behind a CAV that is moving sideways into
+  /// that lane, and the two collide: every CAV collision of the shipped policy's evaluation
+  /// runs was there (issue 18). false = off (the paper: advice applies from x = 0).
+  bool guard_insertion_edge = true;
   /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
   /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
   /// lane-change model makes its own strategic, cooperative and speed-gain changes
@@ -122,6 +129,7 @@ struct GuardCounters {
   std::uint64_t lane_changes_advised = 0;       ///< advised changes received
   std::uint64_t lane_changes_cooled_down = 0;   ///< ... not carried out (cooldown)
   std::uint64_t lane_changes_busy_refused = 0;  ///< ... not carried out (busy zone)
+  std::uint64_t lane_changes_insertion_refused = 0;  ///< ... not carried out (insertion edge)
   std::uint64_t busy_zone_steps = 0;            ///< zone steps a zone was busy (all zones)
   std::uint64_t handbacks = 0;                  ///< CAVs handed back to their own driving
   std::uint64_t handback_steps = 0;             ///< CAV steps spent handed back
@@ -282,6 +290,7 @@ class SumoSession {
   SessionOptions options_;
   std::unique_ptr<RoadLayout> road_;
   std::string end_edge_;         ///< last mainline edge: where onward routes go
+  std::string insertion_edge_;   ///< first mainline edge: where mainline vehicles are inserted
   std::unordered_map<int, std::string> pre_exit_edge_;  ///< cluster -> mainline edge feeding its off-ramp
   std::unordered_set<std::string> index_shift_ahead_;   ///< edges whose successor numbers lanes differently
   std::vector<std::vector<std::pair<double, double>>> lane_shapes_;
