@@ -268,10 +268,16 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   return obs;
 }
 
+ActionMask possibleActions(int lane, int num_lanes) {
+  ActionMask possible = ALL_ACTIONS;
+  if (lane >= num_lanes) possible &= ~actionBit(Action::kLaneLeft);
+  if (lane <= 1) possible &= ~actionBit(Action::kLaneRight);
+  return possible;
+}
+
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes) {
-  const bool no_left = decision.action == Action::kLaneLeft && lane >= num_lanes;
-  const bool no_right = decision.action == Action::kLaneRight && lane <= 1;
-  if (no_left || no_right) decision.action = Action::kKeep;
+  if ((possibleActions(lane, num_lanes) & actionBit(decision.action)) == 0)
+    decision.action = Action::kKeep;
   return decision;
 }
 

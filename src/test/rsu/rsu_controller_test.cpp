@@ -16,6 +16,8 @@
 #include "palcas_core/state/neighbours.h"
 
 using palcas::Action;
+using palcas::ActionMask;
+using palcas::ALL_ACTIONS;
 using palcas::Decision;
 using palcas::GlobalDensities;
 using palcas::ModelBlob;
@@ -95,6 +97,8 @@ RoadSnapshot eightCavs(int call) {
 }
 
 const GlobalDensities GLOBAL{10.0, 20.0, NaN};
+constexpr ActionMask NO_LEFT = ALL_ACTIONS & ~palcas::actionBit(Action::kLaneLeft);
+constexpr ActionMask NO_RIGHT = ALL_ACTIONS & ~palcas::actionBit(Action::kLaneRight);
 const VehicleOutcomes NONE{};
 
 // The only stored transition (replay of size 1: every sample is index 0).
@@ -707,6 +711,15 @@ TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {
   const Decision kept = maskImpossibleLaneChange(accel, 5, 5);
   EXPECT_EQ(kept.action, Action::kAccelerate);
   EXPECT_FLOAT_EQ(kept.accel_mps2, -1.5f);
+}
+
+TEST(RsuController, PossibleActionsRuleOutLaneChangesOffTheMainline) {
+  using palcas::rsu::possibleActions;
+  EXPECT_EQ(possibleActions(1, 5), NO_RIGHT);   // exit lane
+  EXPECT_EQ(possibleActions(0, 5), NO_RIGHT);   // acceleration lane: left merges
+  EXPECT_EQ(possibleActions(3, 5), ALL_ACTIONS);
+  EXPECT_EQ(possibleActions(5, 5), NO_LEFT);    // leftmost
+  EXPECT_EQ(possibleActions(1, 1), NO_RIGHT & NO_LEFT);  // one-lane road: accelerate, keep
 }
 
 TEST(RsuController, AdviseDefersTheGradientStepsToLearn) {

@@ -121,9 +121,14 @@ struct RsuControllerStats {
   uint32_t federation_round = 0;  ///< global models loaded so far
 };
 
-/// A lane change that leaves the mainline lanes (left from lane L; right from lane 1 or from
-/// the acceleration lane, lane 0) becomes KEEP: the bridge would refuse it, and the replay
-/// should hold the action that was executed. Other decisions are returned unchanged.
+/// The actions a CAV in `lane` may take: all but a lane change that leaves the mainline
+/// lanes (left from lane L; right from lane 1 or from the acceleration lane, lane 0). The
+/// one rule behind the advisories (maskImpossibleLaneChange).
+ActionMask possibleActions(int lane, int num_lanes);
+
+/// A decision outside possibleActions(lane, num_lanes) becomes KEEP: the bridge would refuse
+/// it, and the replay should hold the action that was executed. Other decisions are
+/// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 
 /// One RSU k: membership, batched PDQN decisions, transitions, gradient steps, federation
