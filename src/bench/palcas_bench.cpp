@@ -66,7 +66,7 @@ void prefill(PdqnAgent& agent, int count) {
   for (int i = 0; i < count; ++i) {
     const Decision d{static_cast<Action>(rng.uniformIndex(4)), rng.uniform(-4.5f, 2.6f)};
     agent.remember(randomStates(s, 1, rng).col(0), d, rng.uniform(-1, 1),
-                   randomStates(s, 1, rng).col(0), i % 100 == 99);
+                   randomStates(s, 1, rng).col(0), ALL_ACTIONS, i % 100 == 99);
   }
 }
 

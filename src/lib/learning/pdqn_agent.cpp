@@ -1,7 +1,5 @@
 #include "palcas_core/learning/pdqn_agent.h"
 
-#include "palcas_core/state/state_layout.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -44,15 +42,13 @@ void softUpdate(nn::Network& target, const nn::Network& online, float tau) {
 
 }  // namespace
 
-void PdqnAgent::maskInvalidNextActions(const nn::Matrix& next_states, nn::Matrix& q) const {
-  // Ego lane feature = lane / L (0 on the acceleration lane).
-  const int lanes = lanesOfStateSize(config_.state_size);
-  const nn::Index lane_row = static_cast<nn::Index>(EgoFeature::kLane);
+void PdqnAgent::maskInvalidNextActions(const std::vector<ActionMask>& next_valid_actions,
+                                       nn::Matrix& q) {
   constexpr float BLOCKED = -std::numeric_limits<float>::infinity();
-  for (nn::Index j = 0; j < next_states.cols(); ++j) {
-    const int lane = static_cast<int>(std::lround(next_states(lane_row, j) * lanes));
-    if (lane >= lanes) q(static_cast<nn::Index>(Action::kLaneLeft), j) = BLOCKED;
-    if (lane <= 1) q(static_cast<nn::Index>(Action::kLaneRight), j) = BLOCKED;
+  for (nn::Index j = 0; j < q.cols(); ++j) {
+    const ActionMask valid = next_valid_actions[static_cast<size_t>(j)];
+    for (nn::Index a = 0; a < ACTION_COUNT; ++a)
+      if ((valid & actionBit(static_cast<Action>(a))) == 0) q(a, j) = BLOCKED;
   }
 }
 
@@ -183,10 +179,12 @@ void PdqnAgent::evaluate(const nn::Matrix& states, nn::Matrix& q_values,
 }
 
 void PdqnAgent::remember(const nn::Vector& state, const Decision& decision, float reward,
-                         const nn::Vector& next_state, bool done) {
+                         const nn::Vector& next_state, ActionMask next_valid_actions,
+                         bool done) {
   const float accel =
       std::clamp(decision.accel_mps2, config_.accel_min_mps2, config_.accel_max_mps2);
-  replay_.push(state, static_cast<int>(decision.action), accel, reward, next_state, done);
+  replay_.push(state, static_cast<int>(decision.action), accel, reward, next_state,
+               next_valid_actions, done);
 }
 
 bool PdqnAgent::canUpdate() const {
@@ -215,7 +213,13 @@ UpdateStats PdqnAgent::update() {
   return stats;
 }
 
-void PdqnAgent::nextStateValues(const nn::Matrix& next_states, nn::Matrix& values) {
+void PdqnAgent::nextStateValues(const nn::Matrix& next_states,
+                                const std::vector<ActionMask>& next_valid_actions,
+                                nn::Matrix& values) {
+  if (next_valid_actions.size() != static_cast<size_t>(next_states.cols()))
+    throw std::invalid_argument("PdqnAgent::nextStateValues: " +
+                                std::to_string(next_valid_actions.size()) + " masks for " +
+                                std::to_string(next_states.cols()) + " next states");
   // Targets are in eval mode and change every C steps only (hard copies): their folds are
   // reused between copies.
   mu_target_fold_.refresh(mu_target_);
@@ -223,7 +227,7 @@ void PdqnAgent::nextStateValues(const nn::Matrix& next_states, nn::Matrix& value
   c_norm_ = mu_target_fold_.forward(next_states);
   buildQInput(next_states, c_norm_, q_in_);
   selectQ(q_target_fold_.forward(q_in_), next_states.cols(), q_sel_);
-  if (config_.td_target_valid_actions) maskInvalidNextActions(next_states, q_sel_);
+  if (config_.td_target_valid_actions) maskInvalidNextActions(next_valid_actions, q_sel_);
   values = q_sel_.colwise().maxCoeff();
 }
 
@@ -231,7 +235,7 @@ float PdqnAgent::updateQ() {
   const nn::Index n = config_.batch_size;
   const nn::Index passes = config_.multi_pass ? ACTION_COUNT : 1;
   // y = r + gamma (1 - done) max_a' Q_target(s', mu_target(s'))_a'   (P-DQN TD target)
-  nextStateValues(batch_.next_states, next_values_);
+  nextStateValues(batch_.next_states, batch_.next_valid_actions, next_values_);
   target_y_ = batch_.rewards.array() + config_.gamma * (1.0f - batch_.dones.array()) *
                                            next_values_.array();
   // Prediction Q_phi(s, c)_a with the stored (executed) parameter.

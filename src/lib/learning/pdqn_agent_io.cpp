@@ -8,7 +8,10 @@
 namespace palcas {
 
 namespace {
-constexpr uint32_t CHECKPOINT_EXTRA_VERSION = 1;
+// 2: each transition stores the valid actions of its next state. 1: none stored (the agent
+// read them out of the next state's ego-lane feature); read with a mask rebuild.
+constexpr uint32_t CHECKPOINT_EXTRA_VERSION = 2;
+constexpr uint32_t CHECKPOINT_EXTRA_VERSION_WITHOUT_MASKS = 1;
 }
 
 std::string PdqnAgent::layoutId() const {
@@ -71,12 +74,18 @@ std::string PdqnAgent::writeExtra() const {
   return w.bytes();
 }
 
-void PdqnAgent::readExtra(const std::string& extra, const std::string& what) {
+void PdqnAgent::readExtra(const std::string& extra, const std::string& what,
+                          const NextStateMaskRebuild& rebuild_masks) {
   nn::ByteReader r(extra, what + " (checkpoint state)");
   const uint32_t version = r.u32();
-  if (version != CHECKPOINT_EXTRA_VERSION)
+  const bool without_masks = version == CHECKPOINT_EXTRA_VERSION_WITHOUT_MASKS;
+  if (version != CHECKPOINT_EXTRA_VERSION && !without_masks)
     throw std::runtime_error(what + ": checkpoint state version " + std::to_string(version) +
                              ", expected " + std::to_string(CHECKPOINT_EXTRA_VERSION));
+  if (without_masks && !rebuild_masks)
+    throw std::runtime_error(what + ": checkpoint state version " + std::to_string(version) +
+                             " stores no valid-action masks with its transitions, and no way "
+                             "to rebuild them from the next states was given");
   const std::vector<float> mu_t = r.floats(), q_t = r.floats();
   try {
     mu_target_.setState(mu_t.data(), static_cast<nn::Index>(mu_t.size()));
@@ -89,7 +98,10 @@ void PdqnAgent::readExtra(const std::string& extra, const std::string& what) {
   if ((mu_opt_.momentSize() != 0 && mu_opt_.momentSize() != mu_.parameterCount()) ||
       (q_opt_.momentSize() != 0 && q_opt_.momentSize() != q_.parameterCount()))
     throw std::runtime_error(what + ": optimiser state does not match the networks");
-  replay_.read(r);
+  if (without_masks)
+    replay_.readWithoutMasks(r, rebuild_masks);
+  else
+    replay_.read(r);
   epsilon_ = r.f64();
   if (!(epsilon_ >= 0 && epsilon_ <= 1))
     throw std::runtime_error(what + ": epsilon " + std::to_string(epsilon_) + " outside [0, 1]");
@@ -113,7 +125,8 @@ void PdqnAgent::saveCheckpoint(const std::string& path) const {
   nn::writeModelFile(path, c);
 }
 
-void PdqnAgent::loadCheckpoint(const std::string& path) {
+void PdqnAgent::loadCheckpoint(const std::string& path,
+                               const NextStateMaskRebuild& rebuild_masks) {
   nn::FileContents c = nn::readModelFile(path, nn::FileKind::kAgentCheckpoint);
   if (c.layout != layoutId())
     throw std::runtime_error(path + " holds layout '" + c.layout + "', this agent is '" +
@@ -125,7 +138,7 @@ void PdqnAgent::loadCheckpoint(const std::string& path) {
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
-  loaded.readExtra(c.extra, path);
+  loaded.readExtra(c.extra, path, rebuild_masks);
   *this = std::move(loaded);
 }
 

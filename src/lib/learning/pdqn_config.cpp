@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "palcas_core/state/state_layout.h"
-
 namespace palcas {
 
 namespace {
@@ -51,9 +49,6 @@ void PdqnConfig::validate() const {
           "must be in [0, 1]");
   require(epsilon_linear_rounds >= 0 && std::isfinite(epsilon_linear_rounds),
           "epsilon_linear_rounds", epsilon_linear_rounds, "must be finite and >= 0");
-  require(!td_target_valid_actions || lanesOfStateSize(state_size) >= 1, "state_size", state_size,
-          "must be " + std::to_string(LANE_INDEPENDENT_FEATURE_COUNT) +
-              " + L (L >= 1) with td_target_valid_actions");
   require(accel_noise_std_mps2 >= 0 && std::isfinite(accel_noise_std_mps2),
           "accel_noise_std_mps2", accel_noise_std_mps2, "must be >= 0");
 }

@@ -20,10 +20,12 @@ ReplayBuffer::ReplayBuffer(nn::Index state_size, size_t capacity)
   params_.resize(capacity);
   rewards_.resize(capacity);
   dones_.resize(capacity);
+  next_valid_actions_.resize(capacity);
 }
 
 void ReplayBuffer::push(const nn::Vector& state, int action, float param, float reward,
-                        const nn::Vector& next_state, bool done) {
+                        const nn::Vector& next_state, ActionMask next_valid_actions,
+                        bool done) {
   if (state.size() != state_size_ || next_state.size() != state_size_)
     throw std::invalid_argument("ReplayBuffer::push: states must have " +
                                 std::to_string(state_size_) + " values, got " +
@@ -31,6 +33,10 @@ void ReplayBuffer::push(const nn::Vector& state, int action, float param, float 
                                 std::to_string(next_state.size()));
   if (!isValidActionCode(action))
     throw std::invalid_argument("ReplayBuffer::push: unknown action " + std::to_string(action));
+  if (!isValidActionMask(next_valid_actions))
+    throw std::invalid_argument("ReplayBuffer::push: next_valid_actions " +
+                                std::to_string(next_valid_actions) +
+                                " is not a non-empty set of actions");
   if (!state.allFinite() || !next_state.allFinite())
     throw std::invalid_argument("ReplayBuffer::push: non-finite value in a state");
   if (!std::isfinite(param) || !std::isfinite(reward))
@@ -42,6 +48,7 @@ void ReplayBuffer::push(const nn::Vector& state, int action, float param, float 
   params_[next_] = param;
   rewards_[next_] = reward;
   dones_[next_] = done ? 1.0f : 0.0f;
+  next_valid_actions_[next_] = next_valid_actions;
   next_ = (next_ + 1) % capacity_;  // ring: the oldest slot is overwritten when full
   if (size_ < capacity_) ++size_;
 }
@@ -56,6 +63,7 @@ void ReplayBuffer::sample(size_t batch_size, Rng& rng, ReplayBatch& out) const {
   out.params.resize(1, n);
   out.rewards.resize(1, n);
   out.dones.resize(1, n);
+  out.next_valid_actions.resize(batch_size);
   for (nn::Index j = 0; j < n; ++j) {
     const size_t i = rng.uniformIndex(size_);  // storage columns [0, size_) are all valid
     const auto col = static_cast<nn::Index>(i);
@@ -65,6 +73,7 @@ void ReplayBuffer::sample(size_t batch_size, Rng& rng, ReplayBatch& out) const {
     out.params(0, j) = params_[i];
     out.rewards(0, j) = rewards_[i];
     out.dones(0, j) = dones_[i];
+    out.next_valid_actions[j] = next_valid_actions_[i];
   }
 }
 
@@ -77,6 +86,9 @@ size_t ReplayBuffer::slot(size_t i) const {
 
 int ReplayBuffer::actionAt(size_t i) const { return actions_[slot(i)]; }
 float ReplayBuffer::rewardAt(size_t i) const { return rewards_[slot(i)]; }
+ActionMask ReplayBuffer::nextValidActionsAt(size_t i) const {
+  return next_valid_actions_[slot(i)];
+}
 
 void ReplayBuffer::write(nn::ByteWriter& out) const {
   out.u64(static_cast<uint64_t>(state_size_));
@@ -92,9 +104,19 @@ void ReplayBuffer::write(nn::ByteWriter& out) const {
   out.floats(params_.data(), size_);
   out.floats(rewards_.data(), size_);
   out.floats(dones_.data(), size_);
+  const std::vector<float> masks(next_valid_actions_.begin(),
+                                 next_valid_actions_.begin() + static_cast<long>(size_));
+  out.floats(masks.data(), size_);
 }
 
-void ReplayBuffer::read(nn::ByteReader& in) {
+void ReplayBuffer::read(nn::ByteReader& in) { readRecord(in, nullptr); }
+
+void ReplayBuffer::readWithoutMasks(nn::ByteReader& in, const NextStateMaskRebuild& rebuild) {
+  if (!rebuild) throw std::invalid_argument("ReplayBuffer::readWithoutMasks: no mask rebuild");
+  readRecord(in, &rebuild);
+}
+
+void ReplayBuffer::readRecord(nn::ByteReader& in, const NextStateMaskRebuild* rebuild) {
   const uint64_t state_size = in.u64(), capacity = in.u64(), size = in.u64(), next = in.u64();
   if (state_size != static_cast<uint64_t>(state_size_) || capacity != capacity_)
     throw std::runtime_error("ReplayBuffer::read: record has state size " +
@@ -112,6 +134,27 @@ void ReplayBuffer::read(nn::ByteReader& in) {
   for (float action : a)
     if (!isValidActionCode(static_cast<int>(action)))
       throw std::runtime_error("ReplayBuffer::read: unknown action in the record");
+  std::vector<ActionMask> masks(size);
+  if (rebuild) {
+    for (size_t i = 0; i < size; ++i) {
+      const int mask = (*rebuild)(Eigen::Map<const nn::Vector>(
+          s2.data() + i * static_cast<size_t>(state_size_), state_size_));
+      if (!isValidActionMask(mask))
+        throw std::runtime_error("ReplayBuffer::read: rebuilt mask " + std::to_string(mask) +
+                                 " of transition " + std::to_string(i) +
+                                 " is not a non-empty set of actions");
+      masks[i] = static_cast<ActionMask>(mask);
+    }
+  } else {
+    const std::vector<float> m = in.floats();
+    if (m.size() != size)
+      throw std::runtime_error("ReplayBuffer::read: mask count does not match the record size");
+    for (size_t i = 0; i < size; ++i) {
+      if (!isValidActionMask(static_cast<int>(m[i])))
+        throw std::runtime_error("ReplayBuffer::read: invalid action mask in the record");
+      masks[i] = static_cast<ActionMask>(m[i]);
+    }
+  }
   // All checks passed: commit.
   size_ = size;
   next_ = next;
@@ -121,6 +164,7 @@ void ReplayBuffer::read(nn::ByteReader& in) {
   std::copy(p.begin(), p.end(), params_.begin());
   std::copy(r.begin(), r.end(), rewards_.begin());
   std::copy(d.begin(), d.end(), dones_.begin());
+  std::copy(masks.begin(), masks.end(), next_valid_actions_.begin());
 }
 
 }  // namespace palcas

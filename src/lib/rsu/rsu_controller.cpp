@@ -90,6 +90,7 @@ void VehicleOutcomes::clear() {
 struct Closure {
   std::string id;
   nn::Vector next_state;
+  ActionMask next_valid_actions = ALL_ACTIONS;  ///< possibleActions of the CAV in s'
   double reward = 0.0;
   bool done = false;
 };
@@ -212,8 +213,10 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
     }
   };
   // Closes a pending CAV that left the road: collision / teleport pay, an exit earns.
+  // Terminal: s' = s, so the mask is that of s (done zeroes the bootstrap; the mask of s'
+  // anyway keeps every target what it was when the agent decoded it, bit for bit).
   auto closeRemoved = [&](const std::string& id, const Pending& p) {
-    Closure c{id, p.state, p.lastReward(), true};
+    Closure c{id, p.state, p.valid_actions, p.lastReward(), true};
     if (penalised.count(id) > 0) c.reward -= options_.collision_penalty;
     if (exited.count(id) > 0) c.reward += options_.exit_taken_bonus;
     if (merge_failed.count(id) > 0) c.reward -= options_.merge_failed_penalty;
@@ -232,13 +235,15 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
     } else if (member != member_column.end()) {
       const size_t col = static_cast<size_t>(member->second);
       Closure c{id, obs.member_states.col(member->second),
+                possibleActions(obs.member_lanes[col], options_.num_lanes),
                 pending.periodReward(obs.member_rewards[col], over_period), false};
       applyOutcomePenalties(c, pending, *road->second);
       obs.closures.push_back(std::move(c));
     } else if (road != on_road.end() && onOffRamp(*road->second)) {
       // On an off-ramp: a controlled CAV only ever leaves by its own (the bridge commits
       // the exit from lane 1), so this is the exit taken.
-      Closure c{id, pending.state, pending.lastReward() + options_.exit_taken_bonus, true};
+      Closure c{id, pending.state, pending.valid_actions,
+                pending.lastReward() + options_.exit_taken_bonus, true};
       obs.closures.push_back(std::move(c));
     } else if (road != on_road.end()) {
       elsewhere.push_back(id);  // filled below in one batch
@@ -257,6 +262,7 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
       const Pending& p = pending_.at(elsewhere[i]);
       const bool handed_over = v.is_cav && (v.lane >= 1 || v.on_accel_lane);
       Closure c{elsewhere[i], states.col(static_cast<nn::Index>(i)),
+                possibleActions(v.lane, options_.num_lanes),
                 p.periodReward(rewards[i], over_period), !handed_over};
       applyOutcomePenalties(c, p, v);
       obs.closures.push_back(std::move(c));
@@ -268,10 +274,16 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   return obs;
 }
 
+ActionMask possibleActions(int lane, int num_lanes) {
+  ActionMask possible = ALL_ACTIONS;
+  if (lane >= num_lanes) possible &= ~actionBit(Action::kLaneLeft);
+  if (lane <= 1) possible &= ~actionBit(Action::kLaneRight);
+  return possible;
+}
+
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes) {
-  const bool no_left = decision.action == Action::kLaneLeft && lane >= num_lanes;
-  const bool no_right = decision.action == Action::kLaneRight && lane <= 1;
-  if (no_left || no_right) decision.action = Action::kKeep;
+  if ((possibleActions(lane, num_lanes) & actionBit(decision.action)) == 0)
+    decision.action = Action::kKeep;
   return decision;
 }
 
@@ -334,6 +346,7 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
     for (size_t i = 0; i < decisions.size(); ++i) {
       Pending p;
       p.state = obs.member_states.col(static_cast<nn::Index>(i));
+      p.valid_actions = possibleActions(obs.member_lanes[i], options_.num_lanes);
       p.decision = decisions[i];
       p.reward = obs.member_rewards[i];
       p.distance_to_exit_m = obs.member_exit_m[i];
@@ -348,7 +361,8 @@ void RsuController::closePending(const Observation& obs) {
   for (const Closure& c : obs.closures) {
     const auto in_limbo = limbo_.find(c.id);
     const Pending& p = in_limbo != limbo_.end() ? in_limbo->second : pending_.at(c.id);
-    agent_.remember(p.state, p.decision, static_cast<float>(c.reward), c.next_state, c.done);
+    agent_.remember(p.state, p.decision, static_cast<float>(c.reward), c.next_state,
+                    c.next_valid_actions, c.done);
     sum += c.reward;
   }
   // R_k = sum over the CAVs of the per-CAV reward (paper "Reward Function").

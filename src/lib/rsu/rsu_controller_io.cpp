@@ -13,6 +13,7 @@
 
 #include "palcas_core/common/atomic_file.h"
 #include "palcas_core/rsu/rsu_controller.h"
+#include "palcas_core/state/state_layout.h"
 
 namespace palcas::rsu {
 
@@ -174,7 +175,16 @@ void RsuController::loadCheckpoint(const std::string& dir) {
     throw std::runtime_error(path + ": written by an agent of another layout (checksum " +
                              std::to_string(c.layout_checksum) + ", this agent " +
                              std::to_string(agent_.layoutChecksum()) + ")");
-  agent_.loadCheckpoint(joinPath(dir, AGENT_FILE));  // throws std::runtime_error, untouched
+  // An agent.ckpt written before the masks were stored holds transitions without them: the
+  // lane of s' is read from its ego-lane feature (lane / L) as the agent read it then, so a
+  // resumed training computes the same TD targets as if it had not stopped.
+  const int lanes = options_.num_lanes;
+  const nn::Index lane_row = StateLayout(lanes).ego(EgoFeature::kLane);
+  const auto mask_of_next_state = [lanes, lane_row](const nn::Vector& next_state) {
+    return possibleActions(static_cast<int>(std::lround(next_state(lane_row) * lanes)), lanes);
+  };
+  // throws std::runtime_error, agent untouched
+  agent_.loadCheckpoint(joinPath(dir, AGENT_FILE), mask_of_next_state);
   samples_since_federation_ = c.samples_since_federation;
   gradient_credit_ = c.gradient_credit;
   grad_steps_at_round_ = c.grad_steps_at_round;

@@ -17,3 +17,14 @@ TEST(Action, NamesAndValidity) {
   EXPECT_FALSE(palcas::isValidActionCode(4));
   EXPECT_FALSE(palcas::isValidActionCode(-1));
 }
+
+TEST(Action, MasksHoldOneBitPerActionCode) {
+  EXPECT_EQ(palcas::actionBit(palcas::Action::kLaneLeft), 1);
+  EXPECT_EQ(palcas::actionBit(palcas::Action::kLaneRight), 2);
+  EXPECT_EQ(palcas::actionBit(palcas::Action::kKeep), 8);
+  EXPECT_EQ(palcas::ALL_ACTIONS, 15);
+  EXPECT_TRUE(palcas::isValidActionMask(palcas::ALL_ACTIONS));
+  EXPECT_TRUE(palcas::isValidActionMask(palcas::actionBit(palcas::Action::kKeep)));
+  EXPECT_FALSE(palcas::isValidActionMask(0));  // no action left to take
+  EXPECT_FALSE(palcas::isValidActionMask(16));
+}

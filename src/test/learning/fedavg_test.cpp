@@ -100,7 +100,7 @@ TEST(FedAvg, AveragesWholeAgentModelsIncludingBatchNormStatistics) {
         s[f] = data.uniform(0, 3);
         s2[f] = data.uniform(0, 3);
       }
-      agents.back().remember(s, Decision{Action::kKeep, 0.0f}, 1.0f, s2, false);
+      agents.back().remember(s, Decision{Action::kKeep, 0.0f}, 1.0f, s2, ALL_ACTIONS, false);
     }
     agents.back().update();  // training forward passes move the BN running statistics
   }

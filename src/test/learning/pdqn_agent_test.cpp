@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "common/throws_naming.h"
+#include "learning/checkpoint_without_masks.h"
 #include "palcas_core/learning/nn/serialization.h"
 
 using namespace palcas;
@@ -41,7 +43,8 @@ void fillReplay(PdqnAgent& agent, int count, uint64_t seed) {
     const Matrix states = randomStates(s, 1, data);
     const Decision d = agent.act(states, true)[0];
     const float reward = d.action == Action::kAccelerate ? 1.0f - std::abs(d.accel_mps2) : 0.0f;
-    agent.remember(states.col(0), d, reward, randomStates(s, 1, data).col(0), i % 10 == 9);
+    agent.remember(states.col(0), d, reward, randomStates(s, 1, data).col(0), ALL_ACTIONS,
+                   i % 10 == 9);
   }
 }
 
@@ -298,6 +301,59 @@ TEST(PdqnAgent, CheckpointResumesBitIdentically) {
   std::remove(path.c_str());
 }
 
+TEST(PdqnAgent, CheckpointKeepsTheMasksOfTheTransitions) {
+  const std::string path = tempPath("checkpoint_masks.palcas");
+  PdqnAgent a(smallConfig(23));
+  Rng data(14);
+  for (int i = 0; i < 20; ++i)
+    a.remember(randomStates(5, 1, data).col(0), Decision{}, 0.0f, randomStates(5, 1, data).col(0),
+               static_cast<ActionMask>(1 + i % ALL_ACTIONS), false);
+  a.saveCheckpoint(path);
+  PdqnAgent b(smallConfig(23));
+  b.loadCheckpoint(path);
+  ASSERT_EQ(b.replay().size(), 20u);
+  for (size_t i = 0; i < 20; ++i)
+    EXPECT_EQ(b.replay().nextValidActionsAt(i), a.replay().nextValidActionsAt(i)) << i;
+  std::remove(path.c_str());
+}
+
+TEST(PdqnAgent, CheckpointWithoutMasksIsReadOnlyWithAWayToRebuildThem) {
+  // Checkpoints written before the masks travelled with the transitions: the agent cannot
+  // read a mask out of a state, so the caller that knows the state layout rebuilds them.
+  const std::string path = tempPath("checkpoint_v1.palcas");
+  PdqnAgent a(smallConfig(24));
+  fillReplay(a, 40, 15);
+  for (int i = 0; i < 2; ++i) a.update();
+  a.saveCheckpoint(path);
+  palcas_test::dropMasksFromCheckpoint(path);
+
+  PdqnAgent refused(smallConfig(25));
+  const std::vector<float> before = refused.exportModel().values;
+  palcas_test::expectThrowNaming<std::runtime_error>([&] { refused.loadCheckpoint(path); },
+                                                     path + ": checkpoint state version 1");
+  EXPECT_EQ(refused.exportModel().values, before);
+  EXPECT_EQ(refused.replay().size(), 0u);
+
+  // Rebuilt from each transition's own next state (here: its first feature's sign).
+  auto rebuild = [](const Vector& next_state) {
+    return next_state(0) > 0 ? ALL_ACTIONS : actionBit(Action::kKeep);
+  };
+  PdqnAgent b(smallConfig(25));
+  b.loadCheckpoint(path, rebuild);
+  EXPECT_EQ(b.exportModel().values, a.exportModel().values);
+  EXPECT_EQ(b.gradientSteps(), 2u);
+  ASSERT_EQ(b.replay().size(), 40u);
+  Rng ra(16), rb(16);
+  ReplayBatch batch_a, batch_b;
+  a.replay().sample(64, ra, batch_a);
+  b.replay().sample(64, rb, batch_b);
+  EXPECT_EQ(batch_b.next_states, batch_a.next_states);
+  EXPECT_EQ(batch_b.rewards, batch_a.rewards);
+  for (Index j = 0; j < 64; ++j)
+    EXPECT_EQ(batch_b.next_valid_actions[j], rebuild(batch_b.next_states.col(j))) << j;
+  std::remove(path.c_str());
+}
+
 TEST(PdqnAgent, LoadCheckpointRefusesOtherFilesUnchanged) {
   const std::string path = tempPath("checkpoint_other.palcas");
   PdqnConfig wide = smallConfig();
@@ -367,12 +423,17 @@ TEST(PdqnDepartures, DefaultsAreThePapersBehaviour) {
 }
 
 TEST(PdqnDepartures, TdTargetMaxSkipsActionsImpossibleInTheNextState) {
-  // A 3-lane road: state size 43, ego lane feature = lane / 3 at index 4.
+  // The masks a 3-lane road's RSU stores with s': no RIGHT in lane 1, no LEFT in lane 3.
   PdqnConfig c = smallConfig();
-  c.state_size = 43;
   Rng data(5);
-  Matrix next = randomStates(43, 60, data);
-  for (Index j = 0; j < 60; ++j) next(4, j) = static_cast<float>(j % 3 + 1) / 3.0f;  // lanes 1..3
+  const Matrix next = randomStates(5, 60, data);
+  std::vector<ActionMask> masks(60);
+  for (Index j = 0; j < 60; ++j) {
+    const int lane = static_cast<int>(j % 3 + 1);
+    masks[j] = lane == 1   ? ALL_ACTIONS & ~actionBit(Action::kLaneRight)
+               : lane == 3 ? ALL_ACTIONS & ~actionBit(Action::kLaneLeft)
+                           : ALL_ACTIONS;
+  }
   // Teach both agents that LEFT pays (+1, terminal), so LEFT has the largest Q almost
   // everywhere; 51 steps = 17 hard copies (C = 3): the targets then equal the online nets.
   auto trained = [&](bool valid_only) {
@@ -381,8 +442,9 @@ TEST(PdqnDepartures, TdTargetMaxSkipsActionsImpossibleInTheNextState) {
     PdqnAgent agent(cc);
     Rng fill(6);
     for (int i = 0; i < 64; ++i) {
-      const Matrix st = randomStates(43, 1, fill);
-      agent.remember(st.col(0), Decision{Action::kLaneLeft, 0.0f}, 1.0f, st.col(0), true);
+      const Matrix st = randomStates(5, 1, fill);
+      agent.remember(st.col(0), Decision{Action::kLaneLeft, 0.0f}, 1.0f, st.col(0), ALL_ACTIONS,
+                     true);
     }
     for (int i = 0; i < 51; ++i) agent.update();
     return agent;
@@ -391,8 +453,8 @@ TEST(PdqnDepartures, TdTargetMaxSkipsActionsImpossibleInTheNextState) {
   PdqnAgent ours = trained(true);
   Matrix q, accel, v_paper, v_ours;
   ours.evaluate(next, q, accel);
-  paper.nextStateValues(next, v_paper);
-  ours.nextStateValues(next, v_ours);
+  paper.nextStateValues(next, masks, v_paper);  // td_target_valid_actions off: masks unused
+  ours.nextStateValues(next, masks, v_ours);
   int differ = 0;
   for (Index j = 0; j < 60; ++j) {
     const int lane = static_cast<int>(j % 3 + 1);
@@ -409,6 +471,9 @@ TEST(PdqnDepartures, TdTargetMaxSkipsActionsImpossibleInTheNextState) {
     differ += std::abs(v_ours(0, j) - v_paper(0, j)) > 1e-6f;
   }
   EXPECT_GT(differ, 0) << "no column where an impossible action had the largest Q: test is vacuous";
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [&] { ours.nextStateValues(next, std::vector<ActionMask>(59, ALL_ACTIONS), v_ours); },
+      "59 masks for 60 next states");
 }
 
 TEST(PdqnDepartures, SoftTargetUpdateMovesTargetsByTau) {
@@ -437,7 +502,8 @@ TEST(PdqnDepartures, ParamLossCanUseTheAccelerateHeadOnly) {
     PdqnAgent agent(c);
     Rng data(11);
     const Matrix s = randomStates(5, 1, data);
-    for (int i = 0; i < 32; ++i) agent.remember(s.col(0), Decision{Action::kKeep, 0.0f}, 0.0f, s.col(0), false);
+    for (int i = 0; i < 32; ++i)
+      agent.remember(s.col(0), Decision{Action::kKeep, 0.0f}, 0.0f, s.col(0), ALL_ACTIONS, false);
     Matrix q, accel;
     agent.evaluate(s, q, accel);
     const float c_norm = (accel(0, 0) + 0.95f) / 3.55f;  // mu(s) before the update
@@ -467,9 +533,6 @@ TEST(PdqnDepartures, RejectsBadDepartureSettingsNamingThem) {
   c = smallConfig();
   c.epsilon_linear_rounds = -1.0;
   rejected(c, "epsilon_linear_rounds");
-  c = smallConfig();  // state size 5: no ego-lane feature of a 40 + L layout to mask by
-  c.td_target_valid_actions = true;
-  rejected(c, "state_size");
 }
 
 TEST(PdqnDepartures, LinearEpsilonReachesItsFloorAfterTheStatedRounds) {

@@ -92,7 +92,7 @@ void train(PdqnAgent& agent, int rounds, bool learn) {
       next[j] = drawTask(env);
       writeState(next[j], next_states, j);
       agent.remember(states.col(j), decisions[j], reward(tasks[j], decisions[j]),
-                     next_states.col(j), done);
+                     next_states.col(j), ALL_ACTIONS, done);
     }
     tasks.swap(next);
     if (learn && agent.canUpdate()) agent.update();

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include "common/throws_naming.h"
+#include "learning/checkpoint_without_masks.h"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -14,8 +16,11 @@
 
 #include "palcas_core/common/rng.h"
 #include "palcas_core/state/neighbours.h"
+#include "palcas_core/state/state_layout.h"
 
 using palcas::Action;
+using palcas::ActionMask;
+using palcas::ALL_ACTIONS;
 using palcas::Decision;
 using palcas::GlobalDensities;
 using palcas::ModelBlob;
@@ -24,6 +29,8 @@ using palcas::ReplayBatch;
 using palcas::RoadSnapshot;
 using palcas::StateBuilder;
 using palcas::VehicleSnapshot;
+using palcas::nn::Index;
+using palcas::nn::Matrix;
 using palcas::rsu::computeClusterSummary;
 using palcas::rsu::DecisionOutput;
 using palcas::rsu::RsuController;
@@ -79,6 +86,16 @@ VehicleSnapshot cav(const std::string& id, int lane, double x, double v = V_LIMI
   return s;
 }
 
+// A CAV on the acceleration lane (lane 0), 100 m along its 250 m.
+VehicleSnapshot mergingCav(const std::string& id, double x, double v = V_LIMIT, double a = 0.0) {
+  VehicleSnapshot s = cav(id, 0, x, v, a);
+  s.on_accel_lane = true;
+  s.lateral_m = -1.6;
+  s.accel_lane_pos_m = 100.0;
+  s.accel_lane_length_m = 250.0;
+  return s;
+}
+
 RoadSnapshot road(std::vector<VehicleSnapshot> vehicles) {
   RoadSnapshot r;
   r.num_lanes = 5;
@@ -95,6 +112,30 @@ RoadSnapshot eightCavs(int call) {
 }
 
 const GlobalDensities GLOBAL{10.0, 20.0, NaN};
+constexpr ActionMask NO_LEFT = ALL_ACTIONS & ~palcas::actionBit(Action::kLaneLeft);
+constexpr ActionMask NO_RIGHT = ALL_ACTIONS & ~palcas::actionBit(Action::kLaneRight);
+
+// The agent's decode of the TD target's mask before the masks were stored with the
+// transitions (test-only copy): the lane of s' from its ego-lane feature lane / L.
+void oldMaskInvalidNextActions(const Matrix& next_states, int lanes, Matrix& q) {
+  const Index lane_row = static_cast<Index>(palcas::EgoFeature::kLane);
+  constexpr float BLOCKED = -std::numeric_limits<float>::infinity();
+  for (Index j = 0; j < next_states.cols(); ++j) {
+    const int lane = static_cast<int>(std::lround(next_states(lane_row, j) * lanes));
+    if (lane >= lanes) q(static_cast<Index>(Action::kLaneLeft), j) = BLOCKED;
+    if (lane <= 1) q(static_cast<Index>(Action::kLaneRight), j) = BLOCKED;
+  }
+}
+
+// The actions the old decode left in s'.
+ActionMask oldDecodedMask(const palcas::nn::Vector& next_state, int lanes) {
+  Matrix q = Matrix::Zero(palcas::ACTION_COUNT, 1);
+  oldMaskInvalidNextActions(next_state, lanes, q);
+  ActionMask mask = 0;
+  for (Index a = 0; a < palcas::ACTION_COUNT; ++a)
+    if (std::isfinite(q(a, 0))) mask |= palcas::actionBit(static_cast<Action>(a));
+  return mask;
+}
 const VehicleOutcomes NONE{};
 
 // The only stored transition (replay of size 1: every sample is index 0).
@@ -188,11 +229,7 @@ TEST(VehicleOutcomes, AddFilesEventsByKind) {
 
 TEST(RsuController, MembersAreCavsInTheZoneOnMainlineOrAccelerationLane) {
   RsuController c(smallOptions());
-  VehicleSnapshot merging = cav("merging", 0, 1000.0);
-  merging.on_accel_lane = true;
-  merging.lateral_m = -1.6;
-  merging.accel_lane_pos_m = 100.0;
-  merging.accel_lane_length_m = 250.0;
+  const VehicleSnapshot merging = mergingCav("merging", 1000.0);
   VehicleSnapshot ramp = cav("ramp", 0, 1100.0);  // on-ramp before its acceleration lane
   ramp.lateral_m = -5.0;
   VehicleSnapshot hdv = cav("hdv", 2, 1000.0);
@@ -707,6 +744,121 @@ TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {
   const Decision kept = maskImpossibleLaneChange(accel, 5, 5);
   EXPECT_EQ(kept.action, Action::kAccelerate);
   EXPECT_FLOAT_EQ(kept.accel_mps2, -1.5f);
+}
+
+TEST(RsuController, PossibleActionsRuleOutLaneChangesOffTheMainline) {
+  using palcas::rsu::possibleActions;
+  EXPECT_EQ(possibleActions(1, 5), NO_RIGHT);   // exit lane
+  EXPECT_EQ(possibleActions(0, 5), NO_RIGHT);   // acceleration lane: left merges
+  EXPECT_EQ(possibleActions(3, 5), ALL_ACTIONS);
+  EXPECT_EQ(possibleActions(5, 5), NO_LEFT);    // leftmost
+  EXPECT_EQ(possibleActions(1, 1), NO_RIGHT & NO_LEFT);  // one-lane road: accelerate, keep
+}
+
+TEST(RsuController, TransitionsStoreTheValidActionsOfTheirNextState) {
+  // Lanes chosen at the edges of a 5-lane road; the mask is that of s' (the lane now).
+  RsuController c(smallOptions());
+  VehicleSnapshot merging = mergingCav("d", 850.0);
+  c.decide(road({cav("a", 1, 900.0), cav("b", 5, 1000.0), cav("c", 3, 1100.0), merging,
+                 cav("e", 5, 1200.0), cav("f", 1, 1590.0), cav("g", 2, 1300.0)}),
+           1, 0.1, GLOBAL, NONE);
+  merging.x_m = 870.0;
+  VehicleOutcomes events;
+  events.collided = {"e"};  // terminal: s' = s, in lane 5
+  c.decide(road({cav("a", 1, 920.0), cav("b", 5, 1020.0), cav("c", 5, 1120.0), merging,
+                 cav("f", 2, 1605.0) /* handed over */, cav("g", 3, 1320.0)}),
+           2, 0.2, GLOBAL, events);
+  // Stored in id order a..g.
+  const std::vector<ActionMask> expected{NO_RIGHT, NO_LEFT, NO_LEFT, NO_RIGHT,
+                                         NO_LEFT,  ALL_ACTIONS, ALL_ACTIONS};
+  const auto& replay = c.agent().replay();
+  ASSERT_EQ(replay.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i)
+    EXPECT_EQ(int(replay.nextValidActionsAt(i)), int(expected[i])) << "transition " << i;
+  // Each mask is what the agent's old decode read out of that transition's s'.
+  palcas::Rng rng(2);
+  ReplayBatch batch;
+  replay.sample(64, rng, batch);
+  for (Index j = 0; j < 64; ++j)
+    EXPECT_EQ(int(batch.next_valid_actions[j]), int(oldDecodedMask(batch.next_states.col(j), 5)))
+        << j;
+}
+
+TEST(RsuController, TdTargetsWithStoredMasksEqualTheOnesTheOldDecodeGave) {
+  // Twenty CAVs over all lanes and the acceleration lane, three decisions: 40 transitions.
+  RsuControllerOptions o = smallOptions();
+  o.pdqn.td_target_valid_actions = true;
+  o.gradient_steps_per_decision = 0;  // the weights stay those of seed 7
+  RsuController c(o);
+  for (int call = 1; call <= 3; ++call) {
+    std::vector<VehicleSnapshot> v;
+    for (int i = 0; i < 20; ++i) {
+      const std::string id = "c" + std::to_string(10 + i);
+      const int lane = (i + call) % 6;
+      const double x = 820.0 + 38.0 * i + 9.0 * call, speed = 12.0 + i, a = 0.1 * (i % 5) - 0.2;
+      v.push_back(lane == 0 ? mergingCav(id, x, speed, a) : cav(id, lane, x, speed, a));
+    }
+    c.decide(road(v), call, 0.1 * call, GLOBAL, NONE);
+  }
+  ASSERT_EQ(c.agent().replay().size(), 40u);
+  palcas::Rng rng(3);
+  ReplayBatch batch;
+  c.agent().replay().sample(200, rng, batch);
+
+  // An agent taught that lane changes pay (+5, terminal), so they have the largest Q in
+  // many next states and the masks decide the max. 300 steps = 100 hard copies (C = 3):
+  // the targets then equal the online networks, and evaluate() gives the
+  // Q_target(s', mu_target(s')) that the old decode masked.
+  palcas::PdqnConfig taught = o.pdqn;
+  taught.target_update_steps = 3;
+  PdqnAgent agent(taught);
+  for (Index j = 0; j < 64; ++j) {
+    const Decision change{j % 2 == 0 ? Action::kLaneLeft : Action::kLaneRight, 0.0f};
+    agent.remember(batch.states.col(j), change, 5.0f, batch.states.col(j), ALL_ACTIONS, true);
+  }
+  for (int i = 0; i < 300; ++i) agent.update();
+  Matrix q, accel, with_stored_masks;
+  agent.evaluate(batch.next_states, q, accel);
+  agent.nextStateValues(batch.next_states, batch.next_valid_actions, with_stored_masks);
+  Matrix old_masked = q;
+  oldMaskInvalidNextActions(batch.next_states, 5, old_masked);
+  const Matrix old_values = old_masked.colwise().maxCoeff();
+  const float gamma = o.pdqn.gamma;
+  auto tdTargets = [&](const Matrix& values) -> Matrix {
+    return batch.rewards.array() + gamma * (1.0f - batch.dones.array()) * values.array();
+  };
+  const Matrix y_new = tdTargets(with_stored_masks), y_old = tdTargets(old_values);
+  ASSERT_EQ(y_new.cols(), 200);
+  EXPECT_EQ(std::memcmp(y_new.data(), y_old.data(), 200 * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(with_stored_masks.data(), old_values.data(), 200 * sizeof(float)), 0);
+  // Not vacuous: some sampled next state's best action is one the mask rules out.
+  EXPECT_GT((q.colwise().maxCoeff().array() != old_values.array()).count(), 0);
+}
+
+TEST(RsuController, ResumesACheckpointWrittenBeforeTheMasksWereStored) {
+  RsuControllerOptions o = smallOptions();
+  o.pdqn.td_target_valid_actions = true;
+  RsuController c(o);
+  for (int call = 1; call <= 4; ++call) c.decide(eightCavs(call), call, 0.1 * call, GLOBAL, NONE);
+  const std::string dir = freshDir("rsu_ckpt_masks"), old_dir = freshDir("rsu_ckpt_no_masks");
+  c.saveCheckpoint(dir);
+  std::filesystem::copy(dir, old_dir);
+  palcas_test::dropMasksFromCheckpoint(old_dir + "/agent.ckpt");
+
+  RsuController resumed(o), resumed_old(o);
+  resumed.loadCheckpoint(dir);
+  resumed_old.loadCheckpoint(old_dir);  // the masks rebuilt from the lanes of the s'
+  const auto& replay = resumed_old.agent().replay();
+  ASSERT_EQ(replay.size(), 24u);
+  for (size_t i = 0; i < replay.size(); ++i)
+    EXPECT_EQ(int(replay.nextValidActionsAt(i)), int(c.agent().replay().nextValidActionsAt(i)))
+        << i;
+  // Hence the same training from there on.
+  for (int call = 5; call <= 8; ++call)
+    for (RsuController* r : {&resumed, &resumed_old})
+      r->decide(eightCavs(call), call, 0.1 * call, GLOBAL, NONE);
+  EXPECT_GT(resumed_old.agent().gradientSteps(), c.agent().gradientSteps());
+  EXPECT_EQ(resumed_old.exportModel().values, resumed.exportModel().values);
 }
 
 TEST(RsuController, AdviseDefersTheGradientStepsToLearn) {

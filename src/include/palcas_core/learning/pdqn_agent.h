@@ -57,10 +57,12 @@ class PdqnAgent {
   void act(const nn::Matrix& states, bool explore, std::vector<Decision>& out);
   std::vector<Decision> act(const nn::Matrix& states, bool explore);
 
-  /// Stores a transition (accel_mps2 is clipped to the bounds). Throws
-  /// std::invalid_argument like ReplayBuffer::push.
+  /// Stores a transition (accel_mps2 is clipped to the bounds). next_valid_actions: the
+  /// actions that may be taken in next_state (ALL_ACTIONS when nothing is ruled out); the
+  /// agent does not read them out of the state, it does not know what a state encodes.
+  /// Throws std::invalid_argument like ReplayBuffer::push.
   void remember(const nn::Vector& state, const Decision& decision, float reward,
-                const nn::Vector& next_state, bool done);
+                const nn::Vector& next_state, ActionMask next_valid_actions, bool done);
 
   /// True when the replay holds at least one batch.
   bool canUpdate() const;
@@ -70,8 +72,11 @@ class PdqnAgent {
   UpdateStats update();
 
   /// max_a' Q_target(s', mu_target(s'))_a' per column (1 x n): the bootstrap of the TD
-  /// target; with td_target_valid_actions only over the actions act() may take in s'.
-  void nextStateValues(const nn::Matrix& next_states, nn::Matrix& values);
+  /// target; with td_target_valid_actions only over the actions of next_valid_actions[j]
+  /// (one mask per column, stored with the transition). Throws std::invalid_argument on a
+  /// mask count other than the column count.
+  void nextStateValues(const nn::Matrix& next_states,
+                       const std::vector<ActionMask>& next_valid_actions, nn::Matrix& values);
 
   /// Greedy evaluation without exploration or side effects on epsilon: Q values (4 x n)
   /// and accelerations (1 x n, m/s^2). Same preconditions as act().
@@ -91,8 +96,10 @@ class PdqnAgent {
   /// Everything: networks, targets, optimisers, replay, epsilon, counters, RNG state.
   void saveCheckpoint(const std::string& path) const;
   /// Throws std::runtime_error (agent untouched) if the file fails a check or was written
-  /// by an agent of another layout or replay capacity.
-  void loadCheckpoint(const std::string& path);
+  /// by an agent of another layout or replay capacity. A checkpoint written before the
+  /// masks were stored with the transitions gets them from rebuild_masks, and is refused
+  /// (naming the file) without one.
+  void loadCheckpoint(const std::string& path, const NextStateMaskRebuild& rebuild_masks = {});
 
   /// Identifies the architecture: variant, both networks' layouts.
   std::string layoutId() const;
@@ -113,14 +120,16 @@ class PdqnAgent {
   void forwardGreedy(const nn::Matrix& states);  // folded eval mode; fills act_c_, act_q_
   void buildQInput(const nn::Matrix& states, const nn::Matrix& c_norm, nn::Matrix& out) const;
   void selectQ(const nn::Matrix& q_out, nn::Index n, nn::Matrix& out) const;
-  // td_target_valid_actions: -inf for the actions act() may not take in each next state.
-  void maskInvalidNextActions(const nn::Matrix& next_states, nn::Matrix& q) const;
+  // td_target_valid_actions: -inf for the actions outside each column's mask.
+  static void maskInvalidNextActions(const std::vector<ActionMask>& next_valid_actions,
+                                     nn::Matrix& q);
   float updateQ();
   float updateParam();
   float accelFromNorm(float c) const { return accel_mid_ + accel_half_ * c; }
   float normFromAccel(float a) const { return (a - accel_mid_) / accel_half_; }
   std::string writeExtra() const;
-  void readExtra(const std::string& extra, const std::string& what);
+  void readExtra(const std::string& extra, const std::string& what,
+                 const NextStateMaskRebuild& rebuild_masks);
 
   PdqnConfig config_;
   std::unique_ptr<Rng> rng_;  // heap: the dropout layers hold its address across moves

@@ -37,10 +37,10 @@ struct PdqnConfig {
 
   // Departures from the printed paper (src/doc/learning.md, "Departures"); the defaults
   // here are the paper's behaviour.
-  /// true: the TD target's max runs over the actions the policy may take in s' (no LEFT
-  /// from lane L, no RIGHT from lane 1 or the acceleration lane, read from the ego-lane
-  /// feature; needs state_size = 40 + L). false (paper P-DQN): over all four actions,
-  /// including ones act() masks to KEEP and that therefore never get trained.
+  /// true: the TD target's max runs over the actions the policy may take in s', the mask
+  /// stored with each transition (the RSU's: no LEFT from lane L, no RIGHT from lane 1 or
+  /// the acceleration lane). false (paper P-DQN): over all four actions, including ones
+  /// the RSU masks to KEEP and that therefore never get trained.
   bool td_target_valid_actions = false;
   /// > 0: Polyak target update theta' <- tau theta + (1 - tau) theta' after every gradient
   /// step (a horizon of ~1/tau steps, whatever the budget). 0 (paper): hard copy every

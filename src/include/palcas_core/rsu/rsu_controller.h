@@ -121,9 +121,15 @@ struct RsuControllerStats {
   uint32_t federation_round = 0;  ///< global models loaded so far
 };
 
-/// A lane change that leaves the mainline lanes (left from lane L; right from lane 1 or from
-/// the acceleration lane, lane 0) becomes KEEP: the bridge would refuse it, and the replay
-/// should hold the action that was executed. Other decisions are returned unchanged.
+/// The actions a CAV in `lane` may take: all but a lane change that leaves the mainline
+/// lanes (left from lane L; right from lane 1 or from the acceleration lane, lane 0). The
+/// one rule behind both the advisories (maskImpossibleLaneChange) and the valid-action
+/// mask stored with each transition's next state.
+ActionMask possibleActions(int lane, int num_lanes);
+
+/// A decision outside possibleActions(lane, num_lanes) becomes KEEP: the bridge would refuse
+/// it, and the replay should hold the action that was executed. Other decisions are
+/// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 
 /// One RSU k: membership, batched PDQN decisions, transitions, gradient steps, federation
@@ -193,7 +199,8 @@ class RsuController {
   void saveCheckpoint(const std::string& dir) const;
   /// Reads what saveCheckpoint wrote. Throws std::runtime_error (controller untouched) if
   /// a file is missing, not ours, of another rsu_id or layout, or malformed. On success
-  /// the pending transitions are dropped and the previous step forgotten.
+  /// the pending transitions are dropped and the previous step forgotten. An agent.ckpt
+  /// from before the masks were stored gets each transition's mask from the lane of its s'.
   void loadCheckpoint(const std::string& dir);
 
   RsuControllerStats stats() const;
@@ -208,6 +215,7 @@ class RsuController {
   /// A member's last decision, waiting for its outcome.
   struct Pending {
     nn::Vector state;
+    ActionMask valid_actions = ALL_ACTIONS;  ///< in `state`: s' of a transition ending there
     Decision decision;
     double reward = 0.0;  ///< reward at that observation (for terminal transitions)
     double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
