@@ -2,6 +2,8 @@
 // refuses names both values; what agrees passes.
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <string>
 #include <vector>
 
@@ -25,12 +27,8 @@ const std::vector<double> PAPER = {0.0, 800.0, 1600.0, 2400.0};
 
 void expectRefusal(const RsuNodeOptions& o, const std::vector<double>& road, int lanes,
                    const std::string& needle) {
-  try {
-    checkAgainstRoad(o, road, lanes);
-    ADD_FAILURE() << "accepted; expected an error mentioning " << needle;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [&] { checkAgainstRoad(o, road, lanes); }, needle);
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <palcas_common/param_test_cases.h>
 #include <ros/ros.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <functional>
 
@@ -55,12 +57,9 @@ TEST(RsuOptions, WhatIsPinnedMustFitTheBridgesRoad) {
   auto expectMismatch = [](const std::string& name, const std::function<void(ros::NodeHandle&)>& change,
                            const std::string& needle) {
     auto o = loadRsuNodeOptions(caseFrom(name, change));
-    try {
-      palcas::rsu::adoptBridgeRoad(o, {0.0, 800.0, 1600.0, 2400.0}, 4);
-      ADD_FAILURE() << name << ": accepted; expected an error mentioning " << needle;
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+    SCOPED_TRACE(name);
+    palcas_test::expectThrowNaming<std::invalid_argument>(
+        [&] { palcas::rsu::adoptBridgeRoad(o, {0.0, 800.0, 1600.0, 2400.0}, 4); }, needle);
   };
   expectMismatch("lanes5", [](ros::NodeHandle& nh) { nh.setParam("rsu/num_lanes", 5); },
                  "the bridge's road has 4 lanes but rsu/num_lanes is 5");

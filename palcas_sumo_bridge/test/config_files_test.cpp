@@ -5,6 +5,8 @@
 #include <palcas_common/param_defaults.h>
 #include <ros/ros.h>
 
+#include "common/throws_naming.h"
+
 #include "palcas_sumo_bridge/bridge_options.h"
 
 using palcas::bridge::loadBridgeOptions;
@@ -68,42 +70,24 @@ TEST(ConfigFiles, TheV2xChannelIsOffUnlessAFileTurnsItOn) {
   EXPECT_DOUBLE_EQ(o.v2x.rsu_range_m, 509.4);  // MOSAIC SNS's default single-hop radius
   EXPECT_DOUBLE_EQ(o.v2x.max_advice_age_s, 0.5);
   EXPECT_EQ(o.v2x.seed, 104u);
-  try {
-    loadBridgeOptions(ros::NodeHandle("~bad_v2x"));
-    FAIL() << "a loss probability of 1 was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("v2x/advisory/loss_probability"), std::string::npos) << e.what();
-  }
+  // A loss probability of 1.
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [] { loadBridgeOptions(ros::NodeHandle("~bad_v2x")); }, "v2x/advisory/loss_probability");
 }
 
 TEST(ConfigFiles, UnknownKeyIsNamed) {
-  try {
-    loadBridgeOptions(ros::NodeHandle("~typo"));
-    FAIL() << "an unknown key was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("lockstep_dedline"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [] { loadBridgeOptions(ros::NodeHandle("~typo")); }, "lockstep_dedline");
 }
 
 TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
-  try {
-    loadBridgeOptions(ros::NodeHandle("~wrong_type"));
-    FAIL() << "a string deadline was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("lockstep_deadline_s"), std::string::npos) << e.what();
-  }
-  try {
-    loadBridgeOptions(ros::NodeHandle("~out_of_range"));
-    FAIL() << "a penetration rate of 1.2 was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("penetration_rate"), std::string::npos) << e.what();
-  }
-  try {
-    loadBridgeOptions(ros::NodeHandle("~bad_guard"));
-    FAIL() << "a guard floor of 1.5 x the allowed speed was accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("guard_floor_speed_share"), std::string::npos) << e.what();
-  }
+  const auto refused = [](const std::string& ns, const std::string& key) {
+    palcas_test::expectThrowNaming<std::invalid_argument>(
+        [&] { loadBridgeOptions(ros::NodeHandle(ns)); }, key);
+  };
+  refused("~wrong_type", "lockstep_deadline_s");         // a string deadline
+  refused("~out_of_range", "penetration_rate");          // a penetration rate of 1.2
+  refused("~bad_guard", "guard_floor_speed_share");      // a guard floor of 1.5 x allowed speed
 }
 
 int main(int argc, char** argv) {

@@ -5,3 +5,5 @@ palcas_core_add_gtest(rng_test test/common/rng_test.cpp)
 palcas_core_add_gtest(message_auth_test test/common/message_auth_test.cpp)
 # the one atomic file write: replace whole or keep the old file, errors name the file
 palcas_core_add_gtest(atomic_file_test test/common/atomic_file_test.cpp)
+# the shared input checks: the texts they throw
+palcas_core_add_gtest(checks_test test/common/checks_test.cpp)

@@ -1,6 +1,8 @@
 // The demand writer: vehicle-type mix, routes, flows, .sumocfg, and bad configurations.
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -82,12 +84,7 @@ ScenarioConfig twoClusterConfig() {
 
 template <typename F>
 void expectInvalid(F f, const std::string& needle) {
-  try {
-    f();
-    ADD_FAILURE() << "no exception; expected one naming '" << needle << "'";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(f, needle);
 }
 
 }  // namespace

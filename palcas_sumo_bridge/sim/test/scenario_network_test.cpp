@@ -3,6 +3,8 @@
 // (test/data/hand_written_{paper,tiny}).
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <map>
@@ -224,12 +226,8 @@ TEST(ScenarioNetwork, TinyEdgesLayoutAndLinks) {
 
 TEST(ScenarioNetwork, MissingSourcesAreRejectedByName) {
   const std::string empty = freshDir("empty_sources");
-  try {
-    palcas::sim::generateNetwork(empty, freshDir("out_empty"));
-    FAIL() << "no exception";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("network.nod.xml"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [&] { palcas::sim::generateNetwork(empty, freshDir("out_empty")); }, "network.nod.xml");
 }
 
 TEST(ScenarioNetwork, NetconvertFailureCarriesItsOutput) {
@@ -240,14 +238,9 @@ TEST(ScenarioNetwork, NetconvertFailureCarriesItsOutput) {
   std::string edges = palcas::sim::test::slurp(broken + "/network.edg.xml");
   edges.replace(edges.find("from=\"n_start\""), 14, "from=\"n_nowhere\"");
   std::ofstream(broken + "/network.edg.xml") << edges;
-  try {
-    palcas::sim::generateNetwork(broken, freshDir("out_broken"));
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("netconvert failed"), std::string::npos) << what;
-    EXPECT_NE(what.find("n_nowhere"), std::string::npos) << what;  // netconvert's own message
-  }
+  const auto generate = [&] { palcas::sim::generateNetwork(broken, freshDir("out_broken")); };
+  palcas_test::expectThrowNaming<std::runtime_error>(generate, "netconvert failed");
+  palcas_test::expectThrowNaming<std::runtime_error>(generate, "n_nowhere");  // netconvert's own
 }
 
 TEST(ScenarioNetwork, MissingNetconvertIsAClearError) {
@@ -258,12 +251,9 @@ TEST(ScenarioNetwork, MissingNetconvertIsAClearError) {
 
 TEST(ScenarioNetwork, ReadingSomethingThatIsNotANetworkFails) {
   EXPECT_THROW(palcas::sim::readNetEdges("/nonexistent/net.net.xml"), std::runtime_error);
-  try {
-    palcas::sim::readNetEdges(handWrittenDir("paper") + "/network.nod.xml");
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("not a SUMO network"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::runtime_error>(
+      [&] { palcas::sim::readNetEdges(handWrittenDir("paper") + "/network.nod.xml"); },
+      "not a SUMO network");
   EXPECT_THROW(palcas::sim::readNetConnections(scenarioDir("paper") + "/vtypes.xml"),
                std::runtime_error);
 }

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "palcas_core/common/checks.h"
 #include "palcas_core/learning/model_blob.h"
 #include "palcas_core/learning/nn/serialization.h"
 
@@ -13,30 +14,25 @@ namespace palcas {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& what) {
-  throw std::invalid_argument("fedAverage: " + what);
-}
-
 void checkModel(const ModelBlob& m, size_t k, const ModelBlob& first) {
   const BlobCheck check = checkModelBlob(m, &first, "model 0");
-  if (!check.ok()) fail("model " + std::to_string(k) + ": " + check.detail);
+  common::require(check.ok(), "fedAverage: model ", k, ": ", check.detail);
 }
 
 }  // namespace
 
 ModelBlob fedAverage(const std::vector<ModelBlob>& models,
                      const std::vector<uint64_t>& sample_counts, uint64_t max_samples) {
-  if (models.empty()) fail("no models to average");
-  if (sample_counts.size() != models.size())
-    fail(std::to_string(models.size()) + " models but " + std::to_string(sample_counts.size()) +
-         " sample counts");
+  using common::require;
+  require(!models.empty(), "fedAverage: no models to average");
+  require(sample_counts.size() == models.size(), "fedAverage: ", models.size(), " models but ",
+          sample_counts.size(), " sample counts");
   double total = 0.0;
   for (size_t k = 0; k < models.size(); ++k) {
     const uint64_t n_k = sample_counts[k];
-    if (n_k == 0) fail("model " + std::to_string(k) + " has sample count 0");
-    if (n_k > max_samples)
-      fail("model " + std::to_string(k) + " has sample count " + std::to_string(n_k) +
-           " > the plausible maximum " + std::to_string(max_samples));
+    require(n_k != 0, "fedAverage: model ", k, " has sample count 0");
+    require(n_k <= max_samples, "fedAverage: model ", k, " has sample count ", n_k,
+            " > the plausible maximum ", max_samples);
     checkModel(models[k], k, models.front());
     total += static_cast<double>(n_k);
   }

@@ -1,19 +1,17 @@
 #include "palcas_core/learning/pdqn_config.h"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include "palcas_core/common/checks.h"
 
 namespace palcas {
 
 namespace {
 template <typename T>
 void require(bool ok, const char* field, T value, const std::string& rule) {
-  if (ok) return;
-  std::ostringstream msg;
-  msg << "PdqnConfig." << field << " = " << value << " is invalid: " << rule;
-  throw std::invalid_argument(msg.str());
+  common::require(ok, "PdqnConfig.", field, " = ", value, " is invalid: ", rule);
 }
 }  // namespace
 

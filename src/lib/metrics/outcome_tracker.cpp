@@ -1,19 +1,14 @@
 #include "palcas_core/metrics/outcome_tracker.h"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 #include <unordered_set>
 #include <utility>
 
+#include "palcas_core/common/checks.h"
+
 namespace palcas::metrics {
 namespace {
-
-std::string toText(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 std::invalid_argument badField(const std::string& id, const std::string& what) {
   return std::invalid_argument("OutcomeTracker: vehicle '" + id + "': " + what);
@@ -21,26 +16,23 @@ std::invalid_argument badField(const std::string& id, const std::string& what) {
 
 void requireFinite(const std::string& id, const char* field, double value) {
   if (!std::isfinite(value))
-    throw badField(id, std::string(field) + " is " + toText(value) + ", must be finite");
-}
-
-void requireOption(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("OutcomeTrackerOptions: " + what);
+    throw badField(id, common::text(field, " is ", value, ", must be finite"));
 }
 
 }  // namespace
 
 OutcomeTracker::OutcomeTracker(OutcomeTrackerOptions options) : options_(std::move(options)) {
+  using common::require;
+  const char* const bad = "OutcomeTrackerOptions: ";
   for (std::size_t k = 0; k < options_.exit_x_m.size(); ++k)
-    requireOption(std::isfinite(options_.exit_x_m[k]),
-                  "exit_x_m[" + std::to_string(k) + "] is " + toText(options_.exit_x_m[k]) +
-                      ", must be finite");
-  requireOption(std::isfinite(options_.miss_margin_m) && options_.miss_margin_m >= 0.0,
-                "miss_margin_m is " + toText(options_.miss_margin_m) + ", must be >= 0");
-  requireOption(std::isfinite(options_.stop_speed_mps) && options_.stop_speed_mps >= 0.0,
-                "stop_speed_mps is " + toText(options_.stop_speed_mps) + ", must be >= 0");
-  requireOption(std::isfinite(options_.stop_window_m) && options_.stop_window_m >= 0.0,
-                "stop_window_m is " + toText(options_.stop_window_m) + ", must be >= 0");
+    require(std::isfinite(options_.exit_x_m[k]), bad, "exit_x_m[", k, "] is ",
+            options_.exit_x_m[k], ", must be finite");
+  require(std::isfinite(options_.miss_margin_m) && options_.miss_margin_m >= 0.0, bad,
+          "miss_margin_m is ", options_.miss_margin_m, ", must be >= 0");
+  require(std::isfinite(options_.stop_speed_mps) && options_.stop_speed_mps >= 0.0, bad,
+          "stop_speed_mps is ", options_.stop_speed_mps, ", must be >= 0");
+  require(std::isfinite(options_.stop_window_m) && options_.stop_window_m >= 0.0, bad,
+          "stop_window_m is ", options_.stop_window_m, ", must be >= 0");
 }
 
 void OutcomeTracker::validateObservation(const VehicleObservation& obs) const {
@@ -54,7 +46,7 @@ void OutcomeTracker::validateObservation(const VehicleObservation& obs) const {
     throw badField(id, "road_part " + std::to_string(part) + " is not one of 0..3");
   requireFinite(id, "x_m", obs.x_m);
   requireFinite(id, "speed_mps", obs.speed_mps);
-  if (obs.speed_mps < 0.0) throw badField(id, "speed_mps is " + toText(obs.speed_mps) + " < 0");
+  if (obs.speed_mps < 0.0) throw badField(id, common::text("speed_mps is ", obs.speed_mps, " < 0"));
 
   const int clusters = static_cast<int>(options_.exit_x_m.size());
   if (routeHasExit(obs.route_kind) && (obs.exit_cluster < 0 || obs.exit_cluster >= clusters))
@@ -75,8 +67,8 @@ void OutcomeTracker::validateObservation(const VehicleObservation& obs) const {
     requireFinite(id, "accel_lane_pos_m", obs.accel_lane_pos_m);
     requireFinite(id, "accel_lane_length_m", obs.accel_lane_length_m);
     if (obs.accel_lane_length_m <= 0.0)
-      throw badField(id, "accel_lane_length_m is " + toText(obs.accel_lane_length_m) +
-                             " on the acceleration lane, must be > 0");
+      throw badField(id, common::text("accel_lane_length_m is ", obs.accel_lane_length_m,
+                                      " on the acceleration lane, must be > 0"));
   }
 }
 

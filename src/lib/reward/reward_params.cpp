@@ -3,6 +3,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "palcas_core/common/checks.h"
 #include "palcas_core/reward/reward.h"
 
 namespace palcas {
@@ -56,10 +57,6 @@ Member lookup(const std::string& name) {
   throw std::invalid_argument("unknown reward parameter '" + name + "'; valid names: " + valid);
 }
 
-void require(bool ok, const std::string& name, const char* what) {
-  if (!ok) throw std::invalid_argument("reward parameter " + name + " " + what);
-}
-
 }  // namespace
 
 const std::vector<std::string>& rewardParamNames() {
@@ -80,21 +77,25 @@ void setRewardParam(RewardParams& params, const std::string& name, double value)
 }
 
 void validateRewardParams(const RewardParams& p) {
-  for (const auto& row : table()) require(std::isfinite(p.*row.second), row.first, "is not finite");
-  require(p.v_max_ego > p.v_min_ego, "v_max_ego", "must be > v_min_ego (r_ego divides by it)");
-  require(p.v_bar_max > p.v_bar_min, "v_bar_max", "must be > v_bar_min (r_cluster divides by it)");
-  require(std::fabs(p.a_min) - p.a_max != 0.0, "a_min",
-          "must satisfy |a_min| != a_max (r_c divides by it)");
-  require(p.epsilon > 0.0, "epsilon", "must be > 0");
-  require(p.sigma_ttc > 0.0, "sigma_ttc", "must be > 0");
-  require(p.exit_scale > 0.0, "exit_scale", "must be > 0");
-  require(p.beta > 0.0, "beta", "must be > 0");
-  require(p.tau0 >= 0.0, "tau0", "must be >= 0");
+  using common::require;
+  const char* const bad = "reward parameter ";
+  for (const auto& row : table())
+    require(std::isfinite(p.*row.second), bad, row.first, " is not finite");
+  require(p.v_max_ego > p.v_min_ego, bad, "v_max_ego must be > v_min_ego (r_ego divides by it)");
+  require(p.v_bar_max > p.v_bar_min, bad,
+          "v_bar_max must be > v_bar_min (r_cluster divides by it)");
+  require(std::fabs(p.a_min) - p.a_max != 0.0, bad,
+          "a_min must satisfy |a_min| != a_max (r_c divides by it)");
+  require(p.epsilon > 0.0, bad, "epsilon must be > 0");
+  require(p.sigma_ttc > 0.0, bad, "sigma_ttc must be > 0");
+  require(p.exit_scale > 0.0, bad, "exit_scale must be > 0");
+  require(p.beta > 0.0, bad, "beta must be > 0");
+  require(p.tau0 >= 0.0, bad, "tau0 must be >= 0");
   for (const char* flag : {"lateral_rss_overlap_only", "lateral_rss_signed", "comfort_penalty_only"}) {
     const double v = p.*lookup(flag);
-    require(v == 0.0 || v == 1.0, flag, "must be 0 (paper) or 1");
+    require(v == 0.0 || v == 1.0, bad, flag, " must be 0 (paper) or 1");
   }
-  require(p.tte_speed_floor_mps >= 0.0, "tte_speed_floor_mps", "must be >= 0");
+  require(p.tte_speed_floor_mps >= 0.0, bad, "tte_speed_floor_mps must be >= 0");
   validateRssParams(p.rss());
 }
 

@@ -2,27 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
-#include <string>
+
+#include "palcas_core/common/checks.h"
 
 namespace palcas {
-namespace {
-
-void require(bool ok, const char* name, const char* what) {
-  if (!ok) throw std::invalid_argument(std::string("RSS parameter ") + name + " must be " + what);
-}
-
-}  // namespace
 
 void validateRssParams(const RssParams& p) {
-  require(std::isfinite(p.rho_s) && p.rho_s >= 0.0, "rho", "finite and >= 0");
-  require(std::isfinite(p.a_max_mps2) && p.a_max_mps2 >= 0.0, "a_max", "finite and >= 0");
-  require(std::isfinite(p.a_b_min_mps2) && p.a_b_min_mps2 > 0.0, "a_b_min", "finite and > 0");
-  require(std::isfinite(p.a_b_max_mps2) && p.a_b_max_mps2 > 0.0, "a_b_max", "finite and > 0");
-  require(std::isfinite(p.mu_m) && p.mu_m >= 0.0, "mu", "finite and >= 0");
-  require(std::isfinite(p.a_b_lat_mps2) && p.a_b_lat_mps2 > 0.0, "a_b_lat", "finite and > 0");
-  require(std::isfinite(p.a_lat_max_mps2) && p.a_lat_max_mps2 >= 0.0, "a_lat_max",
-          "finite and >= 0");
+  using common::requireNonNegative;
+  using common::requirePositive;
+  requireNonNegative(p.rho_s, "RSS parameter rho");
+  requireNonNegative(p.a_max_mps2, "RSS parameter a_max");
+  requirePositive(p.a_b_min_mps2, "RSS parameter a_b_min");
+  requirePositive(p.a_b_max_mps2, "RSS parameter a_b_max");
+  requireNonNegative(p.mu_m, "RSS parameter mu");
+  requirePositive(p.a_b_lat_mps2, "RSS parameter a_b_lat");
+  requireNonNegative(p.a_lat_max_mps2, "RSS parameter a_lat_max");
 }
 
 // delta_long = [v rho + a_max rho^2/2 + (v + rho a_max)^2/(2 a_b,min) - v_f^2/(2 a_b,max)]_+

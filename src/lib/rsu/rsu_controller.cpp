@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "palcas_core/common/checks.h"
 #include "palcas_core/state/neighbours.h"
 
 namespace palcas::rsu {
@@ -17,10 +18,7 @@ namespace {
 
 template <typename T>
 void require(bool ok, const std::string& field, T value, const std::string& rule) {
-  if (ok) return;
-  std::ostringstream msg;
-  msg << "RsuControllerOptions: " << field << " = " << value << " " << rule;
-  throw std::invalid_argument(msg.str());
+  common::require(ok, "RsuControllerOptions: ", field, " = ", value, " ", rule);
 }
 
 // Runs a nested validator and prefixes its message with the nested struct's name.

@@ -4,26 +4,24 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "palcas_core/common/checks.h"
+
 namespace palcas {
 namespace {
 
 float clip(double value) { return static_cast<float>(std::clamp(value, -1.0, 1.0)); }
 
-void requirePositive(const char* name, double value) {
-  if (!std::isfinite(value) || value <= 0.0)
-    throw std::invalid_argument(std::string("StateScales.") + name + " must be finite and > 0");
-}
-
 }  // namespace
 
 void validateScales(const StateScales& s) {
-  requirePositive("road_length_m", s.road_length_m);
-  requirePositive("lateral_m", s.lateral_m);
-  requirePositive("speed_mps", s.speed_mps);
-  requirePositive("accel_mps2", s.accel_mps2);
-  requirePositive("sensing_range_m", s.sensing_range_m);
-  requirePositive("exit_range_m", s.exit_range_m);
-  requirePositive("jam_density_veh_per_km", s.jam_density_veh_per_km);
+  using common::requirePositive;
+  requirePositive(s.road_length_m, "StateScales.road_length_m");
+  requirePositive(s.lateral_m, "StateScales.lateral_m");
+  requirePositive(s.speed_mps, "StateScales.speed_mps");
+  requirePositive(s.accel_mps2, "StateScales.accel_mps2");
+  requirePositive(s.sensing_range_m, "StateScales.sensing_range_m");
+  requirePositive(s.exit_range_m, "StateScales.exit_range_m");
+  requirePositive(s.jam_density_veh_per_km, "StateScales.jam_density_veh_per_km");
 }
 
 StateBuilder::StateBuilder(int num_lanes, const StateScales& scales)

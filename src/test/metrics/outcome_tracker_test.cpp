@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -328,12 +330,8 @@ TEST(OutcomeTracker, RejectsBadObservationsAndKeepsState) {
     tracker.update({onMainline("old", true, RouteKind::kMainThrough, -1, 10.0)}, {});
     // A valid new vehicle first, then the bad one, plus a removal of "old".
     const auto fresh = onMainline("fresh", true, RouteKind::kMainThrough, -1, 20.0);
-    try {
-      tracker.update({fresh, r.observation}, {{"old"}, {}, {}});
-      ADD_FAILURE() << "no exception";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(r.message_part), std::string::npos) << e.what();
-    }
+    palcas_test::expectThrowNaming<std::invalid_argument>(
+        [&] { tracker.update({fresh, r.observation}, {{"old"}, {}, {}}); }, r.message_part);
     // Nothing applied: "old" still tracked, "fresh" not registered.
     EXPECT_EQ(tracker.trackedVehicles(), 1u);
     EXPECT_EQ(names(tracker.update({fresh}, {{"old"}, {}, {}})),

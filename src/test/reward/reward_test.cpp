@@ -389,14 +389,9 @@ TEST(RewardParams, NamesGetAndSet) {
 
 TEST(RewardParams, UnknownNameListsValidNamesAndChangesNothing) {
   RewardParams p;
-  try {
-    palcas::setRewardParam(p, "lamda", 0.0);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("'lamda'"), std::string::npos) << what;
-    EXPECT_NE(what.find("lambda"), std::string::npos) << what;
-  }
+  const auto setLamda = [&] { palcas::setRewardParam(p, "lamda", 0.0); };
+  palcas_test::expectThrowNaming<std::invalid_argument>(setLamda, "'lamda'");
+  palcas_test::expectThrowNaming<std::invalid_argument>(setLamda, "lambda");
   EXPECT_EQ(p.lambda, 0.4);
 }
 
@@ -404,12 +399,9 @@ TEST(RewardParams, ValidationNamesTheBadConstant) {
   const auto expectBad = [](const std::string& name, double value) {
     RewardParams p;
     palcas::setRewardParam(p, name, value);
-    try {
-      palcas::validateRewardParams(p);
-      ADD_FAILURE() << name << " = " << value << " accepted";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-    }
+    SCOPED_TRACE(testing::Message() << name << " = " << value);
+    palcas_test::expectThrowNaming<std::invalid_argument>(
+        [&] { palcas::validateRewardParams(p); }, name);
   };
   expectBad("epsilon", 0.0);
   expectBad("sigma_ttc", 0.0);

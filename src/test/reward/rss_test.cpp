@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -65,12 +67,8 @@ TEST(Rss, SafetyTermBranches) {
 TEST(Rss, ValidationNamesTheBadParameter) {
   RssParams p;
   p.a_b_min_mps2 = 0.0;
-  try {
-    palcas::validateRssParams(p);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("a_b_min"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { palcas::validateRssParams(p); },
+                                                        "a_b_min");
   p = RssParams();
   p.rho_s = std::nan("");
   EXPECT_THROW(palcas::validateRssParams(p), std::invalid_argument);

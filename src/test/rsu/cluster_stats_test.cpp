@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -80,12 +82,9 @@ TEST(ClusterStats, RejectsBadZoneNamingTheBounds) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const auto& [start, end] : {std::pair<double, double>{800.0, 800.0}, {900.0, 800.0},
                                    {nan, 800.0}, {0.0, nan}}) {
-    try {
-      computeClusterSummary(road, start, end, 33.528);
-      FAIL() << "accepted zone [" << start << ", " << end << ")";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("x_end_m"), std::string::npos) << e.what();
-    }
+    SCOPED_TRACE(testing::Message() << "zone [" << start << ", " << end << ")");
+    palcas_test::expectThrowNaming<std::invalid_argument>(
+        [&, s = start, e = end] { computeClusterSummary(road, s, e, 33.528); }, "x_end_m");
   }
   EXPECT_THROW(computeClusterSummary(road, 0.0, 800.0, -1.0), std::invalid_argument);
   EXPECT_THROW(computeClusterSummary(road, 0.0, 800.0, nan), std::invalid_argument);

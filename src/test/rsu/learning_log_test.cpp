@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -96,10 +98,6 @@ TEST(LearningLog, AnUnwritableFileIsNamed) {
   std::filesystem::create_directories(dir + "/learning.csv");  // a folder where the file goes
   LearningLog log(dir + "/learning.csv", "rsu_0", "train");
   log.addDecision(1, decision(1, -1.0, 0), 1.0);
-  try {
-    log.endEpisode(decision(0, 0.0, 0));
-    ADD_FAILURE() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(dir + "/learning.csv"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::runtime_error>(
+      [&] { log.endEpisode(decision(0, 0.0, 0)); }, dir + "/learning.csv");
 }

@@ -106,12 +106,8 @@ TEST(Neighbours, AccelerationLaneHasLaneOneOnItsLeft) {
 
 TEST(Neighbours, UnknownIdIsRejected) {
   const NeighbourFinder finder(RoadSnapshot{5, {car("a", 1, 0)}});
-  try {
-    finder.find("nobody");
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("nobody"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { finder.find("nobody"); },
+                                                        "nobody");
 }
 
 TEST(Neighbours, BadSnapshotsAreRejectedNamingVehicleAndField) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "common/throws_naming.h"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -144,13 +146,8 @@ TEST(StateBuilder, WorksForOneLane) {
 
 TEST(StateBuilder, RejectsBadInputNamingIt) {
   const StateBuilder builder(5);
-  const auto expectNaming = [&](const std::string& needle, const auto& call) {
-    try {
-      call();
-      ADD_FAILURE() << "expected std::invalid_argument naming " << needle;
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+  const auto expectNaming = [](const std::string& needle, const auto& call) {
+    palcas_test::expectThrowNaming<std::invalid_argument>(call, needle);
   };
   expectNaming("ghost", [&] {
     builder.buildStates(road(), {"cav", "ghost"}, cluster(), global());

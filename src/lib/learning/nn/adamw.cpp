@@ -5,23 +5,20 @@
 #include <stdexcept>
 #include <string>
 
+#include "palcas_core/common/checks.h"
 #include "palcas_core/learning/nn/network.h"
 #include "palcas_core/learning/nn/serialization.h"
 
 namespace palcas::nn {
 
-namespace {
-void require(bool ok, const char* what) {
-  if (!ok) throw std::invalid_argument(std::string("AdamW: ") + what);
-}
-}  // namespace
-
 AdamW::AdamW(const AdamWConfig& c) : config_(c) {
-  require(std::isfinite(c.learning_rate) && c.learning_rate >= 0, "learning_rate must be >= 0");
-  require(c.beta1 >= 0 && c.beta1 < 1, "beta1 must be in [0, 1)");
-  require(c.beta2 >= 0 && c.beta2 < 1, "beta2 must be in [0, 1)");
-  require(std::isfinite(c.eps) && c.eps > 0, "eps must be > 0");
-  require(std::isfinite(c.weight_decay) && c.weight_decay >= 0, "weight_decay must be >= 0");
+  using common::require;
+  require(std::isfinite(c.learning_rate) && c.learning_rate >= 0,
+          "AdamW: learning_rate must be >= 0");
+  require(c.beta1 >= 0 && c.beta1 < 1, "AdamW: beta1 must be in [0, 1)");
+  require(c.beta2 >= 0 && c.beta2 < 1, "AdamW: beta2 must be in [0, 1)");
+  require(std::isfinite(c.eps) && c.eps > 0, "AdamW: eps must be > 0");
+  require(std::isfinite(c.weight_decay) && c.weight_decay >= 0, "AdamW: weight_decay must be >= 0");
 }
 
 void AdamW::step(Network& network) {
