@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "common/throws_naming.h"
+
 using namespace palcas::metrics;
 
 namespace {
@@ -135,11 +137,8 @@ TEST(AdvisoryValidator, ThrowsOnInconsistentInputs) {
   EXPECT_THROW(validateAdvisory(keep, STEP, cavInLane(1, 0), {}, {}), std::invalid_argument);
   EXPECT_THROW(validateAdvisory(keep, STEP, {true, true, 2, true, 5}, {}, {}),
                std::invalid_argument);
-  try {
-    validateAdvisory(keep, STEP, cavInLane(6, 5), {}, {});
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("lane 6 outside 0..5"), std::string::npos) << e.what();
-  }
+  palcas_test::expectThrowNaming<std::invalid_argument>(
+      [&] { validateAdvisory(keep, STEP, cavInLane(6, 5), {}, {}); }, "lane 6 outside 0..5");
   // A vehicle that does not exist is not checked for consistency: it is just unknown.
   const auto verdict = validateAdvisory(keep, STEP, {false, false, 99, true, 0}, {}, {});
   EXPECT_EQ(verdict.reason, RejectionReason::kUnknownVehicle);
