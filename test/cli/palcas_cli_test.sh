@@ -68,6 +68,9 @@ check run_demand_not_a_number  "--demand 'lots'"            run --out "$OUT" --d
 check run_demand_too_high      "--demand '200000': expected a number in [0, 100000]" run --out "$OUT" --demand 200000
 check run_demand_without_value "option --demand needs a value" run --out "$OUT" --demand
 check run_ramp_demand_not_a_number "--ramp-demand '5x'"     run --out "$OUT" --ramp-demand 5x
+check run_sumo_output_unknown  "--sumo-output 'trips': unknown SUMO output (known: fcd tripinfo" run --out "$OUT" --sumo-output fcd,trips
+check run_sumo_output_twice    "--sumo-output 'ssm': named twice" run --out "$OUT" --sumo-output ssm --sumo-output ssm
+check run_sumo_output_without_value "option --sumo-output needs a value" run --out "$OUT" --sumo-output
 check train_demand_negative    "--demand '-1'"              train --out "$OUT" --demand -1
 check train_ramp_demand_too_high "--ramp-demand '1e9'"      train --out "$OUT" --ramp-demand 1e9
 check train_demand_range_reversed "--demand-range '2000,1000': MIN 2000 is greater than MAX 1000" train --out "$OUT" --demand-range 2000,1000

@@ -99,10 +99,12 @@ fi
 result resume_refuses_a_corrupt_checkpoint "$why"
 
 # --demand / --ramp-demand reach the bridge: the default run folder is named by them, and
-# manifest.json, metrics.json and the generated routes file that SUMO ran show them.
+# manifest.json, metrics.json and the generated routes file that SUMO ran show them. The same
+# run asks for two of SUMO's own outputs, which land in the arm's folder.
 status=0
 PALCAS_NO_BUILD=1 PALCAS_RESULTS_DIR="$WORK/results" timeout -k 10 300 "$ROOT/palcas" run --arm keep --no-compare \
-  --scenario tiny --duration 20 --pr 40 --seed 7 --demand 1850 --ramp-demand 420 >"$WORK/demand.log" 2>&1 || status=$?
+  --scenario tiny --duration 20 --pr 40 --seed 7 --demand 1850 --ramp-demand 420 \
+  --sumo-output tripinfo --sumo-output summary >"$WORK/demand.log" 2>&1 || status=$?
 run_dir="$(ls -d "$WORK"/results/run-*-pr40-d1850-r420-s7 2>/dev/null | head -1)"
 why=""
 if [ "$status" -ne 0 ]; then why="the run failed (exit $status): $(tail -3 "$WORK/demand.log")"
@@ -120,6 +122,15 @@ print(m["demand"]["mainline_flow_vphpl"], m["demand"]["onramp_flow_vphpl"], c["m
   [ -n "$why" ] || grep -q "demand=1850 veh/h/lane (ramps 420 veh/h)" "$WORK/demand.log" || why="the run does not say its demand"
 fi
 result run_demand_reaches_the_bridge "$why"
+why=""
+if [ -z "$run_dir" ]; then why="no run folder"
+else
+  grep -q "<tripinfos" "$run_dir/keep/sumo_tripinfo.xml" 2>/dev/null || why+="no SUMO tripinfo in sumo_tripinfo.xml; "
+  grep -q "<summary" "$run_dir/keep/sumo_summary.xml" 2>/dev/null || why+="no SUMO summary in sumo_summary.xml; "
+  [ -e "$run_dir/keep/sumo_fcd.xml" ] && why+="an output nobody asked for (fcd); "
+  grep -q '"sumo_outputs": \[' "$run_dir/keep/manifest.json" || why+="manifest.json does not record sumo_outputs"
+fi
+result run_sumo_outputs_land_in_the_run_folder "$why"
 
 # SIGTERM of ./palcas train or ./palcas run (a scheduler, kill): the command stops every
 # process it started and says so; a training's nodes checkpoint on the way out.
