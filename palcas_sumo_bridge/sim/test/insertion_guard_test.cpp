@@ -16,7 +16,6 @@
 #include "palcas_sim/sumo_session.h"
 #include "scenario_test_util.h"
 
-using palcas::sim::ScenarioConfig;
 using palcas::sim::SessionOptions;
 using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
@@ -26,16 +25,7 @@ namespace {
 constexpr int LANE_LEFT = 0, LANE_RIGHT = 1;
 
 SessionOptions busyTinyRoad(bool guard_on) {
-  ScenarioConfig c;
-  c.scenario_dir = palcas::sim::test::scenarioDir("tiny");
-  c.road = palcas::sim::test::tinyRoad();
-  c.penetration_rate = 1.0;
-  c.mainline_flow_vphpl = 2000.0;
-  c.duration_s = 400.0;
-  c.seed = 11;
-  const auto files = palcas::sim::writeScenario(c, palcas::sim::test::freshDir(guard_on ? "insertion_on" : "insertion_off"));
-  SessionOptions o = palcas::sim::test::sessionOnTiny(guard_on ? "insertion_on_base" : "insertion_off_base");
-  o.sumo_args[1] = files.sumocfg_file;
+  SessionOptions o = palcas::sim::test::sessionOnTiny(guard_on ? "insertion_on" : "insertion_off", 11, 2000.0);
   o.guard_insertion_edge = guard_on;
   o.guard_busy_speed_share = 0.0;  // busy zones would drop the advice: this test is about insertion
   o.guard_busy_leave_share = 0.0;

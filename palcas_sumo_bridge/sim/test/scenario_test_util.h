@@ -56,9 +56,11 @@ inline std::string slurp(const std::string& path) {
 }
 
 // In-process session options on the tiny road with every vehicle a CAV (plenty of
-// candidates), advisory control and the actuation config/bridge.yaml ships.
-inline SessionOptions sessionOnTiny(const std::string& dir_name, unsigned seed = 3) {
+// candidates), advisory control and the actuation config/bridge.yaml ships; mainline_vphpl > 0
+// sets the mainline demand [veh/h/lane] (else ScenarioConfig's default).
+inline SessionOptions sessionOnTiny(const std::string& dir_name, unsigned seed = 3, double mainline_vphpl = 0.0) {
   ScenarioConfig c;
+  if (mainline_vphpl > 0.0) c.mainline_flow_vphpl = mainline_vphpl;
   c.scenario_dir = scenarioDir("tiny");
   c.road = tinyRoad();  // default route shares for its two clusters
   c.penetration_rate = 1.0;
