@@ -379,7 +379,7 @@ def run_launches(root, out, opts, record, args, interrupt):
             monitor = subprocess.Popen(
                 ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(root, "tools", "train_monitor.py"),
                  "--rsus"] + rsu_ids(opts["arm"], clusters)
-                + ["--episodes", str(count), "--first-episode", str(nxt),
+                + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
                    "--duration", number_text(opts["duration"]), "--period", "15"],
                 stderr=subprocess.DEVNULL, env=env)
             while True:

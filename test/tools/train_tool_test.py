@@ -7,6 +7,7 @@ usage: train_tool_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
 import contextlib
 import io
 import json
+import math
 import os
 import pathlib
 import sys
@@ -18,6 +19,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import ship_policy  # noqa: E402
 import train  # noqa: E402
+import train_monitor  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
 NOT_GIVEN = {k: None for k in train.ALL_GIVEN}
@@ -30,6 +32,26 @@ def given(**kw):
     g = dict(NOT_GIVEN)
     g.update(kw)
     return g
+
+
+class MonitorProgress(unittest.TestCase):
+    """A training that draws its traffic per episode runs one launch per episode: the time
+    left must cover the episodes still to come, not only the running one."""
+
+    def test_time_left_covers_every_episode_still_to_run(self):
+        # episode 5 of 36 (0-based 4, first of this launch), 300 of 1200 s after 60 s of wall
+        done, left = train_monitor.progress(4, 4, 36, 1200.0, 300.0, 60.0)
+        self.assertEqual(done, 300.0)
+        self.assertAlmostEqual(left, (32 * 1200.0 - 300.0) * 60.0 / 300.0)
+
+    def test_one_launch_for_every_episode(self):
+        # episodes 0..3 in one launch; the second one half done after 150 s of wall
+        done, left = train_monitor.progress(0, 1, 4, 100.0, 50.0, 150.0)
+        self.assertEqual(done, 150.0)
+        self.assertAlmostEqual(left, 250.0 * 150.0 / 150.0)
+
+    def test_no_progress_yet_gives_no_estimate(self):
+        self.assertTrue(math.isnan(train_monitor.progress(0, 0, 4, 100.0, 0.0, 5.0)[1]))
 
 
 class SettleOptions(unittest.TestCase):
