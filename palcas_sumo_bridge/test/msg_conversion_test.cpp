@@ -17,7 +17,7 @@ palcas::sim::VehicleRecord rampCav() {
   palcas::sim::VehicleRecord r;
   r.id = "f_on1_off2.7";
   r.is_cav = true;
-  r.route_kind = palcas::sim::RouteKind::kRampExit;
+  r.route_kind = palcas::RouteKind::kRampExit;
   r.entry_cluster = 1;
   r.exit_cluster = 2;
   r.length_m = 5.0;

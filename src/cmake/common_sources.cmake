@@ -1,4 +1,4 @@
-# common sources (lib/common/): action codes, the one atomic file write, the random number
+# common sources (lib/common/): action codes, the road's vocabulary (route kinds, road parts), the one atomic file write, the random number
 # generator, the road snapshot every other folder reads, and the HMAC tags that authenticate
 # advisories and model submissions. Includes nothing else of the core.
 list(APPEND PALCAS_CORE_SOURCES
@@ -7,4 +7,5 @@ list(APPEND PALCAS_CORE_SOURCES
   lib/common/road_snapshot.cpp
   lib/common/message_auth.cpp
   lib/common/atomic_file.cpp
+  lib/common/road_terms.cpp
 )

@@ -7,3 +7,5 @@ palcas_core_add_gtest(message_auth_test test/common/message_auth_test.cpp)
 palcas_core_add_gtest(atomic_file_test test/common/atomic_file_test.cpp)
 # the shared input checks: the texts they throw
 palcas_core_add_gtest(checks_test test/common/checks_test.cpp)
+# the road's one vocabulary: codes, names, bad codes refused
+palcas_core_add_gtest(road_terms_test test/common/road_terms_test.cpp)

@@ -6,27 +6,6 @@
 
 namespace palcas::sim {
 
-const char* routeKindName(RouteKind kind) {
-  switch (kind) {
-    case RouteKind::kMainThrough: return "main_through";
-    case RouteKind::kMainExit: return "main_exit";
-    case RouteKind::kRampThrough: return "ramp_through";
-    case RouteKind::kRampExit: return "ramp_exit";
-  }
-  return "unknown";
-}
-
-const char* roadPartName(RoadPart part) {
-  switch (part) {
-    case RoadPart::kMainline: return "mainline";
-    case RoadPart::kAccelLane: return "accel_lane";
-    case RoadPart::kOnRamp: return "on_ramp";
-    case RoadPart::kOffRamp: return "off_ramp";
-    case RoadPart::kUnknown: return "unknown";
-  }
-  return "unknown";
-}
-
 namespace {
 const char* commandName(HeldCommand c) {
   switch (c) {

@@ -23,8 +23,6 @@ namespace api = LIBSUMO_NAMESPACE;
 namespace {
 
 constexpr double INF = std::numeric_limits<double>::infinity();
-// Action codes as palcas::Action / palcas_msgs/Advisory.
-constexpr int LANE_LEFT = 0, LANE_RIGHT = 1, ACCELERATE = 2, KEEP = 3;
 
 // Every variable SUMO builds for every vehicle every step costs time, so the list is short:
 // the lane id carries edge and lane index, and the heading (only for drawing) comes from
@@ -609,20 +607,21 @@ void SumoSession::updateLaneChangeBound(VehicleRecord& v) {
   boundLaneChangeAcceleration(v);
 }
 
-void SumoSession::applyAdvisory(const std::string& id, int action, double accel_mps2) {
+void SumoSession::applyAdvisory(const std::string& id, int action_code, double accel_mps2) {
   auto it = index_.find(id);
   if (it == index_.end()) throw std::invalid_argument("applyAdvisory: unknown vehicle '" + id + "'");
   VehicleRecord& v = vehicles_[it->second];
-  const bool lane_change = action == LANE_LEFT || action == LANE_RIGHT;
-  const int target_lane = action == LANE_LEFT ? v.lane + 1 : v.lane - 1;
+  if (!isValidActionCode(action_code))
+    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action_code));
+  const Action action = static_cast<Action>(action_code);
+  const bool lane_change = action == Action::kLaneLeft || action == Action::kLaneRight;
+  const int target_lane = action == Action::kLaneLeft ? v.lane + 1 : v.lane - 1;
   if (lane_change && road_->hasEdge(v.edge) && road_->sumoLaneIndex(v.edge, target_lane) < 0)
     throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
                                 "' has no lane " + std::to_string(target_lane));
-  if (action == ACCELERATE && !std::isfinite(accel_mps2))
+  if (action == Action::kAccelerate && !std::isfinite(accel_mps2))
     throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
                                 std::to_string(accel_mps2));
-  if (!lane_change && action != ACCELERATE && action != KEEP)
-    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action));
   if (v.handed_back) {
     // Its zone is busy: it drives itself, route and lane changes included (guard_busy_handback).
     ++guard_.handback_advice_dropped;
@@ -631,8 +630,8 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
   }
   if (lane_change) {
     ++guard_.lane_changes_advised;
-    const bool serves_route = (action == LANE_RIGHT && std::isfinite(v.distance_to_exit_m)) ||
-                              (action == LANE_LEFT && v.on_accel_lane);
+    const bool serves_route = (action == Action::kLaneRight && std::isfinite(v.distance_to_exit_m)) ||
+                              (action == Action::kLaneLeft && v.on_accel_lane);
     const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
     const bool busy = zoneBusy(zoneOf(v));
     if (options_.guard_insertion_edge && v.edge == insertion_edge_ && v.lane_change_target == 0) {
@@ -656,7 +655,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action, double accel_
     v.lane_change_edge.clear();
     if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
     holdOwnDriving(v);
-  } else if (action == ACCELERATE) {
+  } else if (action == Action::kAccelerate) {
     const double limit = options_.max_advised_accel_mps2;
     v.command = HeldCommand::kAccelerate;
     v.command_value = limit > 0.0 ? std::clamp(accel_mps2, -limit, limit) : accel_mps2;

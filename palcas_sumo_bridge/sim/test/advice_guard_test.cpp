@@ -14,7 +14,7 @@
 #include "palcas_sim/sumo_session.h"
 #include "scenario_test_util.h"
 
-using palcas::sim::RoadPart;
+using palcas::RoadPart;
 using palcas::sim::SessionOptions;
 using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;

@@ -14,7 +14,7 @@
 #include "palcas_sim/sumo_session.h"
 #include "scenario_test_util.h"
 
-using palcas::sim::RoadPart;
+using palcas::RoadPart;
 using palcas::sim::SessionOptions;
 using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
@@ -48,7 +48,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   // Free traffic: nobody handed back, lane changes are the RSUs'.
   for (const VehicleRecord& v : session.vehicles()) {
     EXPECT_FALSE(v.handed_back) << v.id << " handed back on a free road";
-    if (inZone0(v) && !v.merge_mode) EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE);
+    if (inZone0(v) && !v.merge_mode) { EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE); }
   }
   EXPECT_EQ(session.guardCounters().handbacks, 0u);
 
@@ -64,7 +64,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   std::string sample;
   for (const VehicleRecord& v : session.vehicles()) {
     if (!inZone0(v) || v.merge_mode) {
-      if (v.part == RoadPart::kMainline && v.x_m > 305.0) EXPECT_FALSE(v.handed_back) << v.id << " in the free zone 1";
+      if (v.part == RoadPart::kMainline && v.x_m > 305.0) { EXPECT_FALSE(v.handed_back) << v.id << " in the free zone 1"; }
       continue;
     }
     EXPECT_TRUE(v.handed_back) << v.id << " at x " << v.x_m << " in busy zone 0";

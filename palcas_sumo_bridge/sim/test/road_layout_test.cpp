@@ -4,7 +4,7 @@
 
 using palcas::sim::EdgeInfo;
 using palcas::sim::RoadLayout;
-using palcas::sim::RoadPart;
+using palcas::RoadPart;
 
 namespace {
 // A two-cluster road of 5 lanes: cluster k's merge edge [800k+150, 800k+400) has 6 SUMO

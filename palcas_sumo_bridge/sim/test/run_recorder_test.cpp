@@ -67,10 +67,5 @@ TEST_F(RunRecorderTest, RejectsABadPeriodAndAnUnwritableFolder) {
   EXPECT_ANY_THROW(RunRecorder(dir_ + "/file/sub", 1));
 }
 
-TEST_F(RunRecorderTest, NamesEveryEnumValue) {
-  EXPECT_STREQ(routeKindName(RouteKind::kRampExit), "ramp_exit");
-  EXPECT_STREQ(roadPartName(RoadPart::kAccelLane), "accel_lane");
-}
-
 }  // namespace
 }  // namespace palcas::sim

@@ -13,7 +13,7 @@
 #include "palcas_sim/scenario.h"
 #include "scenario_test_util.h"
 
-using palcas::sim::RoadPart;
+using palcas::RoadPart;
 using palcas::sim::SessionOptions;
 using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
@@ -67,7 +67,7 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
     session.step();
     if (!session.find(mover)) break;
     changed = session.find(mover)->lane == 2;
-    if (!changed) EXPECT_LE(session.find(mover)->accel_mps2, 1.0 + 1e-9) << "step " << i;
+    if (!changed) { EXPECT_LE(session.find(mover)->accel_mps2, 1.0 + 1e-9) << "step " << i; }
   }
   EXPECT_TRUE(changed) << mover << " did not reach lane 2 within 2.5 s";
   EXPECT_GE(session.laneChangesDone(), 1u);
@@ -92,7 +92,7 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
   EXPECT_LT(braked, v0 - 1.0) << braker;
   session.endCommand(braker);
   for (int i = 0; i < 20 && session.find(braker); ++i) session.step();
-  if (session.find(braker)) EXPECT_GT(session.find(braker)->speed_mps, braked + 1.0) << braker;
+  if (session.find(braker)) { EXPECT_GT(session.find(braker)->speed_mps, braked + 1.0) << braker; }
 
   // 3. Own merge: CAVs from the on-ramps reach the mainline without any advisory.
   bool merged = false;

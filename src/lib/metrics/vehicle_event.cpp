@@ -4,28 +4,11 @@
 
 namespace palcas::metrics {
 
-RouteKind routeKindFromCode(int code) {
-  if (code < 0 || code >= ROUTE_KIND_COUNT)
-    throw std::invalid_argument("route_kind code " + std::to_string(code) +
-                                " is not one of 0..3 (VehicleState.ROUTE_*)");
-  return static_cast<RouteKind>(code);
-}
-
 VehicleEventKind vehicleEventKindFromCode(int code) {
   if (code < 0 || code >= VEHICLE_EVENT_KIND_COUNT)
     throw std::invalid_argument("vehicle event kind code " + std::to_string(code) +
                                 " is not one of 0..7 (VehicleEvent constants)");
   return static_cast<VehicleEventKind>(code);
-}
-
-std::string routeKindName(RouteKind kind) {
-  switch (kind) {
-    case RouteKind::kMainThrough: return "main_through";
-    case RouteKind::kMainExit: return "main_exit";
-    case RouteKind::kRampThrough: return "ramp_through";
-    case RouteKind::kRampExit: return "ramp_exit";
-  }
-  return "unknown";
 }
 
 std::string vehicleEventKindName(VehicleEventKind kind) {

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-namespace palcas::sim {
+#include "palcas_core/common/road_terms.h"
 
-enum class RoadPart { kMainline, kAccelLane, kOnRamp, kOffRamp, kUnknown };
+namespace palcas::sim {
 
 /// One edge of the network as the bridge sees it.
 struct EdgeInfo {

@@ -13,11 +13,6 @@
 
 namespace palcas::sim {
 
-/// Text of a route kind as trajectories.csv writes it (main_through, main_exit, ...).
-const char* routeKindName(RouteKind kind);
-/// Text of a road part as trajectories.csv writes it (mainline, accel_lane, ...).
-const char* roadPartName(RoadPart part);
-
 class RunRecorder {
  public:
   static constexpr const char* kTrajectoryHeader =

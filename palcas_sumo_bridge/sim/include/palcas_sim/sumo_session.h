@@ -11,12 +11,11 @@
 #include <unordered_set>
 #include <vector>
 
+#include "palcas_core/common/action.h"
+#include "palcas_core/common/road_terms.h"
 #include "palcas_sim/road_layout.h"
 
 namespace palcas::sim {
-
-/// Route kinds, numbered as palcas_msgs/VehicleState.ROUTE_*.
-enum class RouteKind : int { kMainThrough = 0, kMainExit = 1, kRampThrough = 2, kRampExit = 3 };
 
 /// Longitudinal command a CAV holds between advisories.
 enum class HeldCommand { kNone, kKeepSpeed, kAccelerate };
@@ -228,11 +227,13 @@ class SumoSession {
   /// nullptr when no such vehicle is on the road.
   const VehicleRecord* find(const std::string& id) const;
 
-  /// Applies an already validated advisory (action code as palcas::Action) to a CAV:
-  /// lane changes go through SUMO's changeLane for lane_change_duration_s while the speed
-  /// is held; ACCELERATE holds `accel_mps2`; KEEP holds the current speed.
-  /// @throws std::invalid_argument for an unknown vehicle or a lane that does not exist.
-  void applyAdvisory(const std::string& id, int action, double accel_mps2);
+  /// Applies an already validated advisory (`action_code`: a palcas::Action code, as
+  /// palcas_msgs/Advisory carries it) to a CAV: lane changes go through SUMO's changeLane for
+  /// lane_change_duration_s while the speed is held; ACCELERATE holds `accel_mps2`; KEEP holds
+  /// the current speed.
+  /// @throws std::invalid_argument for an unknown vehicle, an unknown action code, a lane
+  /// that does not exist or a non-finite acceleration.
+  void applyAdvisory(const std::string& id, int action_code, double accel_mps2);
   /// The command of a controlled CAV ended (expired, or its RSU is late or lost): with
   /// own_car_following SUMO's model drives it again, else it keeps its current speed (not on
   /// an off-ramp, where SUMO drives it again). Unknown ids are ignored.

@@ -13,15 +13,9 @@
 
 namespace palcas::metrics {
 
-/// Which part of the road a vehicle is on.
-enum class RoadPart : int {
-  kMainline = 0,   ///< a mainline lane 1..L (the mainline proper)
-  kAccelLane = 1,  ///< an on-ramp's acceleration lane
-  kOnRamp = 2,     ///< an on-ramp before its acceleration lane
-  kOffRamp = 3,    ///< an off-ramp (the bridge must also report junction-internal lanes
-                   ///< leading onto an off-ramp as kOffRamp)
-};
-constexpr int ROAD_PART_COUNT = 4;
+// Which part of the road a vehicle is on (common/road_terms.h).
+using palcas::ROAD_PART_COUNT;
+using palcas::RoadPart;
 
 /// What the bridge sees of one vehicle at one step (a subset of palcas_msgs/VehicleState).
 struct VehicleObservation {

@@ -6,16 +6,17 @@
 
 #include <string>
 
+#include "palcas_core/common/road_terms.h"
+
 namespace palcas::metrics {
 
-/// Where a vehicle entered and whether it leaves by an off-ramp (VehicleState.ROUTE_*).
-enum class RouteKind : int {
-  kMainThrough = 0,  ///< mainline start -> mainline end
-  kMainExit = 1,     ///< mainline start -> an off-ramp
-  kRampThrough = 2,  ///< an on-ramp -> mainline end
-  kRampExit = 3,     ///< an on-ramp -> an off-ramp
-};
-constexpr int ROUTE_KIND_COUNT = 4;
+// The road's vocabulary (common/road_terms.h) under the names the metrics code uses.
+using palcas::ROUTE_KIND_COUNT;
+using palcas::RouteKind;
+using palcas::routeFromRamp;
+using palcas::routeHasExit;
+using palcas::routeKindFromCode;
+using palcas::routeKindName;
 
 /// Kind of a vehicle event (VehicleEvent.DEPARTED ... MERGE_FAILED).
 enum class VehicleEventKind : int {
@@ -40,25 +41,11 @@ struct VehicleEvent {
   double x_m = 0.0;                                ///< longitudinal position there [m]
 };
 
-/// True for routes that end at an off-ramp (they count towards DSR).
-constexpr bool routeHasExit(RouteKind kind) {
-  return kind == RouteKind::kMainExit || kind == RouteKind::kRampExit;
-}
-
-/// True for routes that start on an on-ramp (they count towards MSR).
-constexpr bool routeFromRamp(RouteKind kind) {
-  return kind == RouteKind::kRampThrough || kind == RouteKind::kRampExit;
-}
-
-/// Route kind of a message code 0..3. Throws std::invalid_argument naming the code otherwise.
-RouteKind routeKindFromCode(int code);
-
 /// Event kind of a message code 0..7. Throws std::invalid_argument naming the code otherwise.
 VehicleEventKind vehicleEventKindFromCode(int code);
 
-/// Names used in logs, JSON and CSV ("main_through", ..., "departed", "exit_ok", ...);
-/// "unknown" for a value outside the enum.
-std::string routeKindName(RouteKind kind);
+/// Names used in logs, JSON and CSV ("departed", "exit_ok", ...); "unknown" for a value
+/// outside the enum.
 std::string vehicleEventKindName(VehicleEventKind kind);
 
 }  // namespace palcas::metrics
