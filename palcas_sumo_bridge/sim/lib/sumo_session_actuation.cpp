@@ -1,0 +1,191 @@
+// SumoSession: carrying advice out: advised lane changes (requested, continued across
+// junctions, their acceleration bounded), held ACCELERATE / KEEP commands, and the guard's
+// refusals at the moment advice arrives.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "palcas_sim/sumo_session.h"
+#include "sumo_session_api.h"
+
+namespace palcas::sim {
+
+using namespace session_detail;
+
+void SumoSession::requestLaneChange(VehicleRecord& v, double duration_s) {
+  const int index = road_->sumoLaneIndex(v.edge, v.lane_change_target);
+  if (index < 0) {  // the target lane does not exist on this edge (e.g. the road narrows)
+    v.lane_change_target = 0;
+    return;
+  }
+  if (index_shift_ahead_.count(v.edge) && v.speed_mps > 0.1) {
+    // Stop trying before the boundary: past it this index means another lane.
+    const EdgeInfo& e = road_->edge(v.edge);
+    const double left_m = (e.x_end_m - e.x_start_m) - v.lane_pos_m - v.length_m - 1.0;
+    duration_s = std::min(duration_s, std::max(step_length_s_, left_m / v.speed_mps));
+  }
+  if (traceCommands())
+    std::fprintf(stderr, "[sumo t=%.1f] changeLane %s edge=%s lane=%d pos=%.2f -> index %d for %.1f s\n", time_s_,
+                 v.id.c_str(), v.edge.c_str(), v.sumo_lane_index, v.lane_pos_m, index, duration_s);
+  api::Vehicle::changeLane(v.id, index, duration_s);
+  v.lane_change_edge = v.edge;
+}
+
+bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
+  // SUMO 1.15's sublane model asserts (MSVehicle::getBackPositionOnLane) and aborts the
+  // process when a forced lane change runs while the vehicle straddles a junction: its back
+  // still on the edge behind, or its front about to cross into the next edge, whose lane
+  // indices may differ (merge edges). Requests are issued only well inside an edge.
+  if (!road_->hasEdge(v.edge) || v.lane_pos_m < v.length_m + 0.5) return false;
+  if (!index_shift_ahead_.count(v.edge)) return true;
+  // The next edge numbers its lanes differently: the whole manoeuvre must fit before it.
+  const EdgeInfo& e = road_->edge(v.edge);
+  const double left_m = (e.x_end_m - e.x_start_m) - v.lane_pos_m;
+  const double time_s = std::max(0.0, v.lane_change_until_s - time_s_);
+  return left_m >= v.speed_mps * time_s + v.length_m + 1.0;
+}
+
+void SumoSession::boundLaneChangeAcceleration(VehicleRecord& v) {
+  const double accel = options_.lane_change_max_accel_mps2, decel = options_.lane_change_max_decel_mps2;
+  if ((accel <= 0.0 && decel <= 0.0) || v.lane_change_bounded) return;
+  v.own_accel_mps2 = api::Vehicle::getAccel(v.id);
+  v.own_decel_mps2 = api::Vehicle::getDecel(v.id);
+  if (accel > 0.0) api::Vehicle::setAccel(v.id, std::min(accel, v.own_accel_mps2));
+  if (decel > 0.0) api::Vehicle::setDecel(v.id, std::min(decel, v.own_decel_mps2));
+  v.lane_change_bounded = true;
+}
+
+void SumoSession::restoreLaneChangeAcceleration(VehicleRecord& v) {
+  if (!v.lane_change_bounded) return;
+  api::Vehicle::setAccel(v.id, v.own_accel_mps2);
+  api::Vehicle::setDecel(v.id, v.own_decel_mps2);
+  v.lane_change_bounded = false;
+}
+
+void SumoSession::continueLaneChange(VehicleRecord& v) {
+  if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
+    // Done, or dropped after lane_change_duration_s (no safe gap found in time).
+    ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
+    if (v.lane == v.lane_change_target) v.last_lane_change_s = time_s_;
+    v.lane_change_target = 0;
+    restoreLaneChangeAcceleration(v);
+    return;
+  }
+  updateLaneChangeBound(v);
+  if (v.edge != v.lane_change_edge && wholeOnEdge(v))
+    requestLaneChange(v, v.lane_change_until_s - time_s_);
+}
+
+void SumoSession::updateLaneChangeBound(VehicleRecord& v) {
+  ++guard_.lane_change_steps;
+  if (options_.guard_floor_speed_share > 0.0 && v.speed_mps < guardFloorMps(v)) {
+    // Queued or slowed down: the change must not also hold back how fast it gets going.
+    ++guard_.lane_change_released_steps;
+    restoreLaneChangeAcceleration(v);
+    return;
+  }
+  boundLaneChangeAcceleration(v);
+}
+
+void SumoSession::applyAdvisory(const std::string& id, int action_code, double accel_mps2) {
+  auto it = index_.find(id);
+  if (it == index_.end()) throw std::invalid_argument("applyAdvisory: unknown vehicle '" + id + "'");
+  VehicleRecord& v = vehicles_[it->second];
+  if (!isValidActionCode(action_code))
+    throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action_code));
+  const Action action = static_cast<Action>(action_code);
+  const bool lane_change = action == Action::kLaneLeft || action == Action::kLaneRight;
+  const int target_lane = action == Action::kLaneLeft ? v.lane + 1 : v.lane - 1;
+  if (lane_change && road_->hasEdge(v.edge) && road_->sumoLaneIndex(v.edge, target_lane) < 0)
+    throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
+                                "' has no lane " + std::to_string(target_lane));
+  if (action == Action::kAccelerate && !std::isfinite(accel_mps2))
+    throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
+                                std::to_string(accel_mps2));
+  if (v.handed_back) {
+    // Its zone is busy: it drives itself, route and lane changes included (guard_busy_handback).
+    ++guard_.handback_advice_dropped;
+    v.command = HeldCommand::kNone;
+    return;
+  }
+  if (lane_change) {
+    ++guard_.lane_changes_advised;
+    const bool serves_route = (action == Action::kLaneRight && std::isfinite(v.distance_to_exit_m)) ||
+                              (action == Action::kLaneLeft && v.on_accel_lane);
+    const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
+    const bool busy = zoneBusy(zoneOf(v));
+    if (options_.guard_insertion_edge && v.edge == insertion_edge_ && v.lane_change_target == 0) {
+      // Where SUMO inserts vehicles: a sideways move there meets vehicles inserted into it.
+      ++guard_.lane_changes_insertion_refused;
+      holdOwnDriving(v);
+      return;
+    }
+    if (!serves_route && v.lane_change_target == 0 && (cooling || busy)) {
+      // Weaving for no need of its own route: moments after its last change, or where the
+      // road is busy.
+      ++(busy ? guard_.lane_changes_busy_refused : guard_.lane_changes_cooled_down);
+      holdOwnDriving(v);
+      return;
+    }
+    v.lane_change_target = target_lane;
+    v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
+    updateLaneChangeBound(v);
+    // On a junction, or with its back still on one, the request waits until the vehicle is
+    // wholly on an edge: continueLaneChange issues it there (within the same time budget).
+    v.lane_change_edge.clear();
+    if (wholeOnEdge(v)) requestLaneChange(v, options_.lane_change_duration_s);
+    holdOwnDriving(v);
+  } else if (action == Action::kAccelerate) {
+    const double limit = options_.max_advised_accel_mps2;
+    v.command = HeldCommand::kAccelerate;
+    v.command_value = limit > 0.0 ? std::clamp(accel_mps2, -limit, limit) : accel_mps2;
+  } else {  // KEEP
+    holdOwnDriving(v);
+  }
+}
+
+void SumoSession::endCommand(const std::string& id) {
+  auto it = index_.find(id);
+  if (it == index_.end()) return;
+  VehicleRecord& v = vehicles_[it->second];
+  if (v.part == RoadPart::kOffRamp) return;
+  holdOwnDriving(v);
+}
+
+void SumoSession::applyHeldCommand(VehicleRecord& v) {
+  if (v.command == HeldCommand::kNone || v.part == RoadPart::kOffRamp) {
+    // SUMO's own car following drives it (no command, or it left the mainline): release
+    // our last setSpeed once.
+    if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
+    v.speed_overridden = false;
+    v.command = HeldCommand::kNone;
+    return;
+  }
+  if (v.command == HeldCommand::kKeepSpeed) {
+    v.speed_overridden = true;
+    api::Vehicle::setSpeed(v.id, v.command_value);
+    return;
+  }
+  // Holding an acceleration: aim each step at the speed it reaches in one step. With the
+  // CAV's safe-speed check on (speed mode 31) that target only ever holds it below what its
+  // own car following would do, so the guard bounds how far: never below the floor.
+  ++guard_.accelerate_steps;
+  double target = std::max(0.0, v.speed_mps + v.command_value * step_length_s_);
+  const double floor = guardFloorMps(v);
+  if (target < floor) {
+    if (v.speed_mps < floor) {
+      // Already below it (queued, stopped, blocked): its own driving, at its own rate.
+      ++guard_.accelerate_released_steps;
+      if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
+      v.speed_overridden = false;
+      return;
+    }
+    ++guard_.accelerate_floored_steps;
+    target = floor;
+  }
+  v.speed_overridden = true;
+  api::Vehicle::setSpeed(v.id, target);
+}
+
+}  // namespace palcas::sim

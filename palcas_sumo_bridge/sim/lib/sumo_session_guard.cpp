@@ -1,0 +1,102 @@
+// SumoSession: the advice guard's view of the road: zone speeds, busy zones and the hand-back
+// of their CAVs to their own driving, and the floor below which advice may not slow a CAV.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "palcas_sim/sumo_session.h"
+#include "sumo_session_api.h"
+
+namespace palcas::sim {
+
+using namespace session_detail;
+
+void SumoSession::updateZones() {
+  if (options_.guard_busy_speed_share <= 0.0) return;
+  const std::size_t n = road_->clusters().size();
+  if (zone_speed_share_.size() != n) {
+    zone_speed_share_.assign(n, 1.0);  // an empty road is free
+    zone_busy_.assign(n, false);
+  }
+  std::vector<double> sum(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (const VehicleRecord& v : vehicles_) {
+    if (v.part != RoadPart::kMainline || v.lane < 1 || v.max_speed_mps <= 0.0) continue;
+    const int k = zoneOf(v);
+    if (k < 0 || k >= static_cast<int>(n)) continue;
+    sum[k] += std::min(1.0, v.speed_mps / v.max_speed_mps);
+    ++count[k];
+  }
+  // Exponential smoothing over the window: one jam-free gap or one slow car does not flip it.
+  const double alpha = std::min(1.0, step_length_s_ / std::max(step_length_s_, options_.guard_busy_window_s));
+  const double leave = std::max(options_.guard_busy_leave_share, options_.guard_busy_speed_share);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (count[k] > 0) zone_speed_share_[k] += alpha * (sum[k] / count[k] - zone_speed_share_[k]);
+    if (zone_speed_share_[k] < options_.guard_busy_speed_share) zone_busy_[k] = true;
+    else if (zone_speed_share_[k] > leave) zone_busy_[k] = false;
+    ++guard_.zone_steps;
+    if (zone_busy_[k]) ++guard_.busy_zone_steps;
+  }
+}
+
+int SumoSession::zoneOf(const VehicleRecord& v) const {
+  return static_cast<int>(v.x_m / options_.cluster_length_m);
+}
+
+void SumoSession::holdOwnDriving(VehicleRecord& v) const {
+  v.command = options_.own_car_following ? HeldCommand::kNone : HeldCommand::kKeepSpeed;
+  v.command_value = v.speed_mps;
+}
+
+bool SumoSession::zoneBusy(int cluster) const {
+  return cluster >= 0 && cluster < static_cast<int>(zone_busy_.size()) && zone_busy_[cluster];
+}
+
+double SumoSession::zoneSpeedShare(int cluster) const {
+  return cluster >= 0 && cluster < static_cast<int>(zone_speed_share_.size()) ? zone_speed_share_[cluster] : 1.0;
+}
+
+void SumoSession::updateHandback(VehicleRecord& v) {
+  const bool busy_here = options_.guard_busy_handback && !v.merge_mode && road_->hasEdge(v.edge) &&
+                         (v.part == RoadPart::kMainline || v.part == RoadPart::kAccelLane) &&
+                         zoneBusy(zoneOf(v));
+  if (busy_here == v.handed_back) return;
+  if (options_.assist_mode) {  // it drives itself already: only its advice is dropped
+    v.handed_back = busy_here;
+    if (busy_here) ++guard_.handbacks;
+    return;
+  }
+  if (busy_here) {
+    // Its route to its off-ramp first: a CAV SUMO cannot route (e.g. mid-junction) waits a step.
+    if (v.exit_cluster >= 0 && !v.exit_committed && std::isfinite(v.distance_to_exit_m) && !routeToOwnExit(v))
+      return;
+    api::Vehicle::setLaneChangeMode(v.id, options_.assist_lane_change_mode);
+    v.command = HeldCommand::kNone;  // released in applyHeldCommand
+    v.handed_back = true;
+    ++guard_.handbacks;
+    return;
+  }
+  // Its zone is free again: lane changes (its exit included) are the RSUs' job once more.
+  api::Vehicle::setLaneChangeMode(v.id, options_.cav_lane_change_mode);
+  v.handed_back = false;
+  if (v.exit_cluster >= 0 && !end_edge_.empty() && std::isfinite(v.distance_to_exit_m)) {
+    try {
+      api::Vehicle::changeTarget(v.id, end_edge_);
+    } catch (const libsumo::TraCIException&) {
+      ++route_changes_failed_;  // keeps its route to its exit
+    }
+    v.exit_committed = false;  // manageExit re-commits it in lane 1 before its off-ramp
+  }
+}
+
+double SumoSession::guardFloorMps(const VehicleRecord& v) const {
+  // In a busy zone the floor is the allowed speed itself: advice slows nobody there, the
+  // zone's CAVs drive themselves (only route-serving lane changes are still carried out).
+  const bool busy = zoneBusy(zoneOf(v));
+  const double share = busy ? options_.guard_busy_floor_speed_share : options_.guard_floor_speed_share;
+  if (share <= 0.0) return 0.0;
+  return share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
+}
+
+}  // namespace palcas::sim
