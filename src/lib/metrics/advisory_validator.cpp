@@ -1,19 +1,13 @@
 #include "palcas_core/metrics/advisory_validator.h"
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 #include "palcas_core/common/action.h"
+#include "palcas_core/common/checks.h"
 
 namespace palcas::metrics {
 namespace {
-
-std::string toText(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 AdvisoryVerdict reject(RejectionReason reason, std::string detail) {
   return {false, reason, std::move(detail)};
@@ -23,8 +17,8 @@ void checkInputs(const KnownVehicle& vehicle, const AdvisoryLimits& limits) {
   if (!std::isfinite(limits.accel_min_mps2) || !std::isfinite(limits.accel_max_mps2) ||
       limits.accel_min_mps2 > limits.accel_max_mps2)
     throw std::invalid_argument("AdvisoryLimits: accel_min_mps2 " +
-                                toText(limits.accel_min_mps2) + " / accel_max_mps2 " +
-                                toText(limits.accel_max_mps2) + " must be finite with min <= max");
+                                common::text(limits.accel_min_mps2) + " / accel_max_mps2 " +
+                                common::text(limits.accel_max_mps2) + " must be finite with min <= max");
   if (!vehicle.exists) return;
   if (vehicle.num_lanes < 1)
     throw std::invalid_argument("KnownVehicle: num_lanes " + std::to_string(vehicle.num_lanes) +
@@ -62,11 +56,11 @@ AdvisoryVerdict checkLaneChange(Action action, const KnownVehicle& v) {
 AdvisoryVerdict checkAcceleration(double accel_mps2, const AdvisoryLimits& limits) {
   if (!std::isfinite(accel_mps2))
     return reject(RejectionReason::kNotFinite,
-                  "acceleration " + toText(accel_mps2) + " m/s^2 is not finite");
+                  "acceleration " + common::text(accel_mps2) + " m/s^2 is not finite");
   if (accel_mps2 < limits.accel_min_mps2 || accel_mps2 > limits.accel_max_mps2)
     return reject(RejectionReason::kAccelOutOfRange,
-                  "acceleration " + toText(accel_mps2) + " m/s^2 outside [" +
-                      toText(limits.accel_min_mps2) + ", " + toText(limits.accel_max_mps2) + "]");
+                  "acceleration " + common::text(accel_mps2) + " m/s^2 outside [" +
+                      common::text(limits.accel_min_mps2) + ", " + common::text(limits.accel_max_mps2) + "]");
   return {true, RejectionReason::kUnknownVehicle, ""};
 }
 

@@ -3,19 +3,14 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <sstream>
 #include <stdexcept>
+
+#include "palcas_core/common/checks.h"
 
 namespace palcas::metrics {
 namespace {
 
 constexpr double NOT_A_NUMBER = std::numeric_limits<double>::quiet_NaN();
-
-std::string toText(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
 
 /// 100 * part / whole, NaN when whole == 0 (an empty denominator has no rate).
 double percent(std::uint64_t part, std::uint64_t whole) {
@@ -32,16 +27,16 @@ EpisodeMetricsAccumulator::EpisodeMetricsAccumulator(const EpisodeMetricsOptions
     : options_(options) {
   if (!std::isfinite(options_.comfort_accel_mps2) || options_.comfort_accel_mps2 < 0.0)
     throw std::invalid_argument("EpisodeMetricsOptions: comfort_accel_mps2 is " +
-                                toText(options_.comfort_accel_mps2) + ", must be finite and >= 0");
+                                common::text(options_.comfort_accel_mps2) + ", must be finite and >= 0");
 }
 
 void EpisodeMetricsAccumulator::checkSample(const SpeedSample& sample) {
   if (!std::isfinite(sample.speed_mps) || sample.speed_mps < 0.0)
     throw std::invalid_argument("EpisodeMetricsAccumulator: speed_mps is " +
-                                toText(sample.speed_mps) + ", must be finite and >= 0");
+                                common::text(sample.speed_mps) + ", must be finite and >= 0");
   if (!std::isfinite(sample.accel_mps2))
     throw std::invalid_argument("EpisodeMetricsAccumulator: accel_mps2 is " +
-                                toText(sample.accel_mps2) + ", must be finite");
+                                common::text(sample.accel_mps2) + ", must be finite");
 }
 
 void EpisodeMetricsAccumulator::apply(const SpeedSample& sample) {
@@ -204,8 +199,8 @@ void EpisodeMetricsAccumulator::addLateRsuStep() { ++counts_.late_rsu_steps; }
 
 void EpisodeMetricsAccumulator::setSimSeconds(double sim_seconds) {
   if (!std::isfinite(sim_seconds) || sim_seconds < sim_seconds_)
-    throw std::invalid_argument("EpisodeMetricsAccumulator: sim_seconds " + toText(sim_seconds) +
-                                " must be finite and >= the previous " + toText(sim_seconds_));
+    throw std::invalid_argument("EpisodeMetricsAccumulator: sim_seconds " + common::text(sim_seconds) +
+                                " must be finite and >= the previous " + common::text(sim_seconds_));
   sim_seconds_ = sim_seconds;
 }
 
