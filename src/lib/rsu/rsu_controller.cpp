@@ -45,14 +45,7 @@ void RsuControllerOptions::validate() const {
   require(num_lanes >= 1, "num_lanes", num_lanes, "must be >= 1");
   require(std::isfinite(gradient_steps_per_decision) && gradient_steps_per_decision >= 0.0,
           "gradient_steps_per_decision", gradient_steps_per_decision, "must be finite and >= 0");
-  require(std::isfinite(collision_penalty) && collision_penalty >= 0.0, "collision_penalty",
-          collision_penalty, "must be finite and >= 0 (it is subtracted)");
-  require(std::isfinite(exit_taken_bonus) && exit_taken_bonus >= 0.0, "exit_taken_bonus",
-          exit_taken_bonus, "must be finite and >= 0 (it is added)");
-  require(std::isfinite(exit_missed_penalty) && exit_missed_penalty >= 0.0, "exit_missed_penalty",
-          exit_missed_penalty, "must be finite and >= 0 (it is subtracted)");
-  require(std::isfinite(merge_failed_penalty) && merge_failed_penalty >= 0.0,
-          "merge_failed_penalty", merge_failed_penalty, "must be finite and >= 0 (it is subtracted)");
+  nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
   nested("scales", [&] { validateScales(scales); });
   nested("pdqn", [&] { pdqn.validate(); });
@@ -204,21 +197,23 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   };
   auto onOffRamp = [](const VehicleSnapshot& v) { return v.lane == 0 && !v.on_accel_lane; };
   auto applyOutcomePenalties = [&](Closure& c, const Pending& p, const VehicleSnapshot& v) {
-    if (merge_failed.count(c.id) > 0) c.reward -= options_.merge_failed_penalty;
-    if (passedExit(p, v)) {
-      c.reward -= options_.exit_missed_penalty;
-      if (options_.exit_missed_terminal) c.done = true;
-    }
+    TransitionOutcome o;
+    o.merge_failed = merge_failed.count(c.id) > 0;
+    o.exit_missed = passedExit(p, v);
+    const TransitionReward r = stillOnTheRoad(c.reward, c.done, o, options_.terminal);
+    c.reward = r.reward;
+    c.done = r.done;
   };
   // Closes a pending CAV that left the road: collision / teleport pay, an exit earns.
   // Terminal: s' = s, so the mask is that of s (done zeroes the bootstrap; the mask of s'
   // anyway keeps every target what it was when the agent decoded it, bit for bit).
   auto closeRemoved = [&](const std::string& id, const Pending& p) {
-    Closure c{id, p.state, p.valid_actions, p.lastReward(), true};
-    if (penalised.count(id) > 0) c.reward -= options_.collision_penalty;
-    if (exited.count(id) > 0) c.reward += options_.exit_taken_bonus;
-    if (merge_failed.count(id) > 0) c.reward -= options_.merge_failed_penalty;
-    return c;
+    TransitionOutcome o;
+    o.collided = penalised.count(id) > 0;
+    o.exit_taken = exited.count(id) > 0;
+    o.merge_failed = merge_failed.count(id) > 0;
+    const TransitionReward r = leftTheRoad(p.lastReward(), o, options_.terminal);
+    return Closure{id, p.state, p.valid_actions, r.reward, r.done};
   };
 
   // Last decision's vanished CAVs: their events have arrived by now.
@@ -240,9 +235,10 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
     } else if (road != on_road.end() && onOffRamp(*road->second)) {
       // On an off-ramp: a controlled CAV only ever leaves by its own (the bridge commits
       // the exit from lane 1), so this is the exit taken.
-      Closure c{id, pending.state, pending.valid_actions,
-                pending.lastReward() + options_.exit_taken_bonus, true};
-      obs.closures.push_back(std::move(c));
+      TransitionOutcome exit;
+      exit.exit_taken = true;
+      const TransitionReward r = leftTheRoad(pending.lastReward(), exit, options_.terminal);
+      obs.closures.push_back(Closure{id, pending.state, pending.valid_actions, r.reward, r.done});
     } else if (road != on_road.end()) {
       elsewhere.push_back(id);  // filled below in one batch
     } else {

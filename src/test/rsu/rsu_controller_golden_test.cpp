@@ -75,11 +75,11 @@ RsuControllerOptions goldenOptions() {
   o.gradient_steps_per_decision = 0.75;  // fractional credit
   o.federation_interval_steps = 4;
   // Distinct terminal rewards, so each one shows in the fingerprints.
-  o.collision_penalty = 3.25;
-  o.exit_taken_bonus = 1.5;
-  o.exit_missed_penalty = 7.75;
-  o.exit_missed_terminal = true;
-  o.merge_failed_penalty = 2.5;
+  o.terminal.collision_penalty = 3.25;
+  o.terminal.exit_taken_bonus = 1.5;
+  o.terminal.exit_missed_penalty = 7.75;
+  o.terminal.exit_missed_terminal = true;
+  o.terminal.merge_failed_penalty = 2.5;
   o.reward_over_period = true;
   o.pdqn.hidden_sizes = {16, 16};
   o.pdqn.batch_size = 8;

@@ -21,6 +21,7 @@
 #include "palcas_core/learning/pdqn_config.h"
 #include "palcas_core/metrics/vehicle_event.h"
 #include "palcas_core/reward/reward.h"
+#include "palcas_core/reward/terminal_rewards.h"
 #include "palcas_core/rsu/cluster_stats.h"
 #include "palcas_core/state/state_builder.h"
 
@@ -40,20 +41,9 @@ struct RsuControllerOptions {
   /// Local gradient steps between federation rounds (paper E = 2500); 0 = never due
   /// (independent baseline).
   uint64_t federation_interval_steps = 2500;
-  /// Subtracted from the last reward of a CAV removed by a COLLISION or TELEPORT event
-  /// (>= 0, finite). Default 0: the paper defines no terminal penalty.
-  double collision_penalty = 0.0;
-  // Terminal outcomes (the paper defines none; src/doc/rsu.md "Terminal transitions").
-  // Each is >= 0 and finite; 0 and false are the paper's behaviour.
-  /// Added to the transition that ends on the CAV's own off-ramp (exit taken; terminal).
-  double exit_taken_bonus = 0.0;
-  /// Subtracted from the transition in which a CAV passed its off-ramp without taking it.
-  double exit_missed_penalty = 0.0;
-  /// true: that transition is terminal (the task of reaching the exit ended, failed); the
-  /// CAV's later decisions are new episodes of a through vehicle. false: it goes on.
-  bool exit_missed_terminal = false;
-  /// Subtracted from the transition in which a merging CAV failed (MERGE_FAILED event).
-  double merge_failed_penalty = 0.0;
+  /// Rewards of collisions, exits taken or missed and failed merges (the paper defines
+  /// none: all 0 / false by default; reward/terminal_rewards.h).
+  TerminalRewards terminal;
   /// true: a transition's reward is the mean of the per-step rewards over the period the
   /// decision held (every bridge step up to the next decision, fed by observeStep()).
   /// false (paper): the reward of the one snapshot at the next decision.
@@ -63,7 +53,7 @@ struct RsuControllerOptions {
   PdqnConfig pdqn;      ///< agent hyper-parameters (seed included)
 
   /// Throws std::invalid_argument naming the first bad field ("x_end_m", "pdqn.state_size",
-  /// "reward.rho", ...) and its value.
+  /// "reward: rho", "terminal: collision_penalty", ...) and its value.
   void validate() const;
 };
 
