@@ -192,7 +192,7 @@ void RsuController::loadCheckpoint(const std::string& dir) {
   federation_round_ = static_cast<uint32_t>(c.federation_round);
   stats_.transitions_stored = c.transitions_stored;
   stats_.decisions = c.decisions;
-  pending_.clear();  // they belong to the run that wrote the checkpoint
+  book_.dropPending();  // they belong to the run that wrote the checkpoint
   have_last_step_ = false;
   checkpoint_owned_ = true;  // this process continues that checkpoint and may replace it
   checkpoint_seen_id_ = c.checkpoint_id;

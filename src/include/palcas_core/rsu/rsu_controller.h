@@ -10,8 +10,8 @@
 #include <array>
 #include <cstdint>
 #include <limits>
-#include <map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "palcas_core/common/action.h"
@@ -19,10 +19,10 @@
 #include "palcas_core/learning/model_blob.h"
 #include "palcas_core/learning/pdqn_agent.h"
 #include "palcas_core/learning/pdqn_config.h"
-#include "palcas_core/metrics/vehicle_event.h"
 #include "palcas_core/reward/reward.h"
 #include "palcas_core/reward/terminal_rewards.h"
 #include "palcas_core/rsu/cluster_stats.h"
+#include "palcas_core/rsu/transition_book.h"
 #include "palcas_core/state/state_builder.h"
 
 namespace palcas::rsu {
@@ -55,22 +55,6 @@ struct RsuControllerOptions {
   /// Throws std::invalid_argument naming the first bad field ("x_end_m", "pdqn.state_size",
   /// "reward: rho", "terminal: collision_penalty", ...) and its value.
   void validate() const;
-};
-
-/// Ids of vehicles that something happened to since the previous decide() call (from
-/// palcas_msgs/VehicleEvent). Ids that this RSU does not know are ignored.
-struct VehicleOutcomes {
-  std::vector<std::string> collided;     ///< COLLISION: removed; terminal with penalty
-  std::vector<std::string> teleported;   ///< TELEPORT: removed; terminal with penalty
-  std::vector<std::string> arrived;      ///< ARRIVED: left at its route's end; terminal
-  std::vector<std::string> exited;       ///< EXIT_OK: on its own off-ramp; terminal
-  std::vector<std::string> exit_missed;  ///< EXIT_MISSED: still on the road
-  std::vector<std::string> merge_failed; ///< MERGE_FAILED: penalised, not terminal
-
-  /// Files `id` under the list of `kind`; DEPARTED, MERGE_OK and MERGE_FAILED are ignored
-  /// (they end nothing). Never throws except std::bad_alloc.
-  void add(metrics::VehicleEventKind kind, const std::string& id);
-  void clear();
 };
 
 /// The advisory for one member CAV.
@@ -122,8 +106,9 @@ ActionMask possibleActions(int lane, int num_lanes);
 /// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 
-/// One RSU k: membership, batched PDQN decisions, transitions, gradient steps, federation
-/// bookkeeping and checkpoints for zone [x_start_m, x_end_m). Deterministic for a seed
+/// One RSU k: membership, batched PDQN decisions, transitions (stored as its TransitionBook
+/// closes them), gradient steps, federation bookkeeping and checkpoints for zone
+/// [x_start_m, x_end_m). Deterministic for a seed
 /// (one Eigen thread). Not thread-safe: call from one thread. Movable, not copyable.
 class RsuController {
  public:
@@ -199,41 +184,28 @@ class RsuController {
   uint32_t modelVersion() const { return model_version_; }
   uint32_t federationRound() const { return federation_round_; }
   /// Members whose last decision waits for its outcome (train mode).
-  size_t pendingCount() const { return pending_.size(); }
+  size_t pendingCount() const { return book_.pendingCount(); }
 
  private:
-  /// A member's last decision, waiting for its outcome.
-  struct Pending {
-    nn::Vector state;
-    ActionMask valid_actions = ALL_ACTIONS;  ///< in `state`: s' of a transition ending there
-    Decision decision;
-    double reward = 0.0;  ///< reward at that observation (for terminal transitions)
-    double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
-    double period_reward_sum = 0.0;   ///< rewards of the steps since (reward_over_period)
-    int period_steps = 0;
-    /// The reward the transition gets: the period mean including `now` when kept.
-    double periodReward(double now, bool over_period) const {
-      return over_period ? (period_reward_sum + now) / (period_steps + 1) : now;
-    }
-    /// Mean reward since the decision, or the decision's own when no step was seen.
-    double lastReward() const {
-      return period_steps > 0 ? period_reward_sum / period_steps : reward;
-    }
-  };
   struct Observation;  // everything decide() computes before changing any state
 
   Observation observe(const RoadSnapshot& snapshot, const GlobalDensities& global,
                       const VehicleOutcomes& outcomes) const;
-  void closePending(const Observation& obs);
+  std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
+                                                      const MemberColumns& columns,
+                                                      const PendingFates& fates,
+                                                      const RoadIndex& road,
+                                                      const NeighbourFinder& finder,
+                                                      const ClusterStats& stats,
+                                                      const GlobalDensities& global) const;
+  /// Remembers the closed transitions (id order) and counts them for the stats and n_k.
+  void storeClosures(const std::vector<Closure>& closures);
   void runGradientSteps();
 
   RsuControllerOptions options_;
   StateBuilder builder_;
   PdqnAgent agent_;
-  std::map<std::string, Pending> pending_;  // ordered: transitions are stored by id
-  // Vanished without an event: its COLLISION / ARRIVED event may still be on its way
-  // (another topic), so the transition is closed one decision later.
-  std::map<std::string, Pending> limbo_;
+  TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
   double gradient_credit_ = 0.0;
