@@ -88,8 +88,8 @@ bool RsuController::isMember(const VehicleSnapshot& v) const {
 
 bool RsuController::federationDue() const {
   const uint64_t steps = agent_.gradientSteps();
-  return options_.federation_interval_steps > 0 && steps >= grad_steps_at_round_ &&
-         steps - grad_steps_at_round_ >= options_.federation_interval_steps;
+  return options_.federation_interval_steps > 0 && steps >= counters_.grad_steps_at_round &&
+         steps - counters_.grad_steps_at_round >= options_.federation_interval_steps;
 }
 
 namespace {
@@ -221,14 +221,14 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   DecisionOutput out;
   out.step = step;
   out.time_s = time_s;
-  out.model_version = model_version_;
+  out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
   if (!obs.member_ids.empty()) agent_.act(obs.member_states, options_.train, decisions);
   for (size_t i = 0; i < decisions.size(); ++i)
     decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);
 
-  stats_.decisions++;
+  counters_.decisions++;
   stats_.member_count = static_cast<uint32_t>(obs.member_ids.size());
   stats_.action_counts.fill(0);
   out.advisories.reserve(decisions.size());
@@ -264,22 +264,22 @@ void RsuController::storeClosures(const std::vector<Closure>& closures) {
   stats_.transitions_closed = static_cast<uint32_t>(closures.size());
   stats_.sum_reward = sum;
   stats_.mean_reward = closures.empty() ? std::nan("") : sum / closures.size();
-  stats_.transitions_stored += closures.size();
-  samples_since_federation_ += closures.size();
+  counters_.transitions_stored += closures.size();
+  counters_.samples_since_federation += closures.size();
 }
 
 void RsuController::runGradientSteps() {
   // Credit is earned only while the replay holds a batch, so a long warm-up does not
   // turn into a burst of updates later.
   if (!agent_.canUpdate()) return;
-  gradient_credit_ += options_.gradient_steps_per_decision;
-  while (gradient_credit_ >= 1.0 - CREDIT_EPSILON) {
+  counters_.gradient_credit += options_.gradient_steps_per_decision;
+  while (counters_.gradient_credit >= 1.0 - CREDIT_EPSILON) {
     const UpdateStats u = agent_.update();
     stats_.q_loss = u.q_loss;
     stats_.param_loss = u.param_loss;
-    gradient_credit_ -= 1.0;
+    counters_.gradient_credit -= 1.0;
   }
-  if (gradient_credit_ < 0.0) gradient_credit_ = 0.0;  // absorb the tolerance
+  if (counters_.gradient_credit < 0.0) counters_.gradient_credit = 0.0;  // absorb the tolerance
 }
 
 void RsuController::observeStep(const RoadSnapshot& snapshot) {
@@ -308,9 +308,11 @@ RsuControllerStats RsuController::stats() const {
   RsuControllerStats s = stats_;
   s.epsilon = agent_.epsilon();
   s.gradient_steps = agent_.gradientSteps();
-  s.samples_since_federation = samples_since_federation_;
-  s.model_version = model_version_;
-  s.federation_round = federation_round_;
+  s.decisions = counters_.decisions;
+  s.samples_since_federation = counters_.samples_since_federation;
+  s.transitions_stored = counters_.transitions_stored;
+  s.model_version = counters_.model_version;
+  s.federation_round = counters_.federation_round;
   return s;
 }
 

@@ -730,6 +730,41 @@ TEST(RsuController, LoadCheckpointRefusesFilesThatAreNotOursAndStaysUntouched) {
   refused(garbage, "unknown key 'bogus'");
 }
 
+// controller.txt's format is fixed: these keys in this order (checkpoints written by every
+// earlier version load), and a file from before checkpoint_id existed loads.
+TEST(RsuController, ControllerFileKeepsItsKeysAndLoadsWithoutACheckpointId) {
+  RsuController c(smallOptions());
+  for (int call = 1; call <= 3; ++call) c.decide(eightCavs(call), call, 0.1 * call, GLOBAL, NONE);
+  const std::string dir = freshDir("rsu_ckpt_format");
+  c.saveCheckpoint(dir);
+  std::ifstream in(dir + "/controller.txt");
+  std::string line, without_id;
+  std::vector<std::string> keys;
+  while (std::getline(in, line)) {
+    keys.push_back(line.substr(0, line.find(' ')));
+    if (keys.back() != "checkpoint_id") without_id += line + "\n";
+  }
+  EXPECT_EQ(keys, (std::vector<std::string>{"palcas_rsu_controller", "rsu_id", "layout_checksum",
+                                            "samples_since_federation", "gradient_credit",
+                                            "grad_steps_at_round", "model_version",
+                                            "federation_round", "transitions_stored", "decisions",
+                                            "checkpoint_id"}));
+  std::ofstream(dir + "/controller.txt") << without_id;
+  RsuController old(smallOptions());
+  old.loadCheckpoint(dir);
+  EXPECT_EQ(old.stats().decisions, 3u);
+  EXPECT_EQ(old.stats().transitions_stored, 16u);  // 8 CAVs closed at calls 2 and 3
+  EXPECT_EQ(old.samplesSinceFederation(), 16u);
+
+  RsuController other(smallOptions());
+  std::string too_big = without_id;
+  too_big.replace(too_big.find("model_version 0"), 15, "model_version 4294967296");
+  std::ofstream(dir + "/controller.txt") << too_big;
+  palcas_test::expectThrowNaming<std::runtime_error>([&] { other.loadCheckpoint(dir); },
+                                                     "beyond 32 bits");
+  EXPECT_EQ(other.stats().decisions, 0u);  // untouched
+}
+
 TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {
   using palcas::rsu::maskImpossibleLaneChange;
   const Decision left{Action::kLaneLeft, 0.0f}, right{Action::kLaneRight, 0.0f};

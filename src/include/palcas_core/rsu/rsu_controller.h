@@ -106,6 +106,19 @@ ActionMask possibleActions(int lane, int num_lanes);
 /// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 
+/// The controller's counters that a checkpoint carries beside the agent: one key of
+/// controller.txt each (the one list of the keys: rsu_controller_io.cpp; src/doc/rsu.md,
+/// "Checkpoints").
+struct ControllerCounters {
+  uint64_t samples_since_federation = 0;  ///< n_k
+  double gradient_credit = 0.0;           ///< gradient steps earned but not made, in [0, 1)
+  uint64_t grad_steps_at_round = 0;       ///< the agent's gradient steps at the last global model
+  uint32_t model_version = 0;
+  uint32_t federation_round = 0;          ///< global models loaded so far
+  uint64_t transitions_stored = 0;
+  uint64_t decisions = 0;                 ///< decide() / advise() calls
+};
+
 /// One RSU k: membership, batched PDQN decisions, transitions (stored as its TransitionBook
 /// closes them), gradient steps, federation bookkeeping and checkpoints for zone
 /// [x_start_m, x_end_m). Deterministic for a seed
@@ -154,7 +167,7 @@ class RsuController {
   /// The local model to submit (online networks).
   ModelBlob exportModel() const { return agent_.exportModel(); }
   /// n_k: transitions stored since the last loadGlobalModel() (or construction).
-  uint64_t samplesSinceFederation() const { return samples_since_federation_; }
+  uint64_t samplesSinceFederation() const { return counters_.samples_since_federation; }
   /// Imports the global model and starts a new round: clears the due flag and n_k,
   /// sets the model version, counts the round. Throws std::invalid_argument (local model
   /// and counters kept) on another layout, a bad checksum, wrong size, non-finite value,
@@ -181,8 +194,8 @@ class RsuController {
   RsuControllerStats stats() const;
   const RsuControllerOptions& options() const { return options_; }
   const PdqnAgent& agent() const { return agent_; }
-  uint32_t modelVersion() const { return model_version_; }
-  uint32_t federationRound() const { return federation_round_; }
+  uint32_t modelVersion() const { return counters_.model_version; }
+  uint32_t federationRound() const { return counters_.federation_round; }
   /// Members whose last decision waits for its outcome (train mode).
   size_t pendingCount() const { return book_.pendingCount(); }
 
@@ -208,12 +221,8 @@ class RsuController {
   TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
-  double gradient_credit_ = 0.0;
-  uint64_t samples_since_federation_ = 0;
-  uint64_t grad_steps_at_round_ = 0;
-  uint32_t model_version_ = 0;
-  uint32_t federation_round_ = 0;
-  RsuControllerStats stats_;
+  ControllerCounters counters_;  // what a checkpoint carries besides the agent
+  RsuControllerStats stats_;      // of the last decision (counters_ and the agent's aside)
   // The checkpoint this controller continues (loaded or last wrote): saveCheckpoint only
   // replaces a file with this id (mutable: saving does not change what the controller does).
   mutable bool checkpoint_owned_ = false;
