@@ -135,8 +135,8 @@ std::unordered_map<std::string, StateNow> RsuController::statesNow(
   const std::vector<double> rewards = rewardsOf(finder, fates.outside_zone, stats, options_.reward);
   for (size_t i = 0; i < fates.outside_zone.size(); ++i) {
     const std::string& id = fates.outside_zone[i];
-    now[id] = StateNow{states.col(static_cast<nn::Index>(i)), possibleActions(road.at(id)->lane, lanes),
-                       rewards[i]};
+    now[id] = StateNow{states.col(static_cast<nn::Index>(i)),
+                       possibleActions(road.at(id)->lane, lanes), rewards[i]};
   }
   return now;
 }
@@ -168,8 +168,9 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   MemberColumns columns;
   for (size_t i = 0; i < obs.member_ids.size(); ++i) columns.emplace(obs.member_ids[i], i);
   const PendingFates fates = book_.sort(road, columns, events);
-  obs.closings = book_.close(fates, road, statesNow(obs, columns, fates, road, finder, stats, global),
-                             events, options_.terminal, options_.reward_over_period);
+  const auto now = statesNow(obs, columns, fates, road, finder, stats, global);
+  obs.closings =
+      book_.close(fates, road, now, events, options_.terminal, options_.reward_over_period);
   return obs;
 }
 

@@ -172,7 +172,8 @@ void RsuController::saveCheckpoint(const std::string& dir) const {
     if (!checkpoint_owned_ || on_disk.checkpoint_id != checkpoint_seen_id_)
       throw std::runtime_error(
           dir + " holds a checkpoint this process neither loaded nor wrote (decisions " +
-          std::to_string(on_disk.decisions) + ", this process " + std::to_string(counters_.decisions) +
+          std::to_string(on_disk.decisions) + ", this process " +
+          std::to_string(counters_.decisions) +
           "): another process owns it, so it is not overwritten");
   }
   static thread_local std::mt19937_64 ids{std::random_device{}()};

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "common/throws_naming.h"
+#include "reward/terminal_rewards_amounts.h"
 
 #include <limits>
 #include <stdexcept>
@@ -12,23 +13,13 @@ using palcas::stillOnTheRoad;
 using palcas::TerminalRewards;
 using palcas::TransitionOutcome;
 using palcas::TransitionReward;
+using palcas_test::exactTerminalRewards;
 using palcas_test::expectThrowNaming;
 
 namespace {
 
 constexpr double NaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double INF = std::numeric_limits<double>::infinity();
-
-// Amounts that are exact in binary, so every expected value below is exact too.
-TerminalRewards shipped() {
-  TerminalRewards t;
-  t.collision_penalty = 10.0;
-  t.exit_taken_bonus = 2.0;
-  t.exit_missed_penalty = 8.0;
-  t.exit_missed_terminal = true;
-  t.merge_failed_penalty = 4.0;
-  return t;
-}
 
 TransitionOutcome outcome(bool collided, bool exit_taken, bool exit_missed, bool merge_failed) {
   TransitionOutcome o;
@@ -51,7 +42,7 @@ TEST(TerminalRewards, DefaultsAreThePapersNone) {
 }
 
 TEST(TerminalRewards, LeavingTheRoadIsTerminalAndPaysEachOutcome) {
-  const TerminalRewards t = shipped();
+  const TerminalRewards t = exactTerminalRewards();
   EXPECT_EQ(leftTheRoad(-0.5, TransitionOutcome{}, t).reward, -0.5);  // arrived, vanished
   EXPECT_EQ(leftTheRoad(-0.5, outcome(true, false, false, false), t).reward, -10.5);
   EXPECT_EQ(leftTheRoad(-0.5, outcome(false, true, false, false), t).reward, 1.5);
@@ -63,8 +54,9 @@ TEST(TerminalRewards, LeavingTheRoadIsTerminalAndPaysEachOutcome) {
 }
 
 TEST(TerminalRewards, OnTheRoadAMissedExitEndsTheTransitionOnlyWhenAsked) {
-  TerminalRewards t = shipped();
-  const TransitionReward missed = stillOnTheRoad(-0.25, false, outcome(false, false, true, false), t);
+  TerminalRewards t = exactTerminalRewards();
+  const TransitionReward missed =
+      stillOnTheRoad(-0.25, false, outcome(false, false, true, false), t);
   EXPECT_EQ(missed.reward, -8.25);
   EXPECT_TRUE(missed.done);
   t.exit_missed_terminal = false;
@@ -90,7 +82,7 @@ TEST(TerminalRewards, RejectsBadAmountsAndRewardsNamingThem) {
   bad([](TerminalRewards& t) { t.exit_taken_bonus = INF; }, "exit_taken_bonus = inf");
   bad([](TerminalRewards& t) { t.exit_missed_penalty = -0.5; }, "exit_missed_penalty");
   bad([](TerminalRewards& t) { t.merge_failed_penalty = NaN; }, "merge_failed_penalty");
-  EXPECT_NO_THROW(palcas::validateTerminalRewards(shipped()));
+  EXPECT_NO_THROW(palcas::validateTerminalRewards(exactTerminalRewards()));
   expectThrowNaming<std::invalid_argument>(
       [] { leftTheRoad(NaN, TransitionOutcome{}, TerminalRewards{}); }, "reward_so_far");
   expectThrowNaming<std::invalid_argument>(

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "common/throws_naming.h"
+#include "reward/terminal_rewards_amounts.h"
 
 #include <limits>
 #include <map>
@@ -14,7 +15,6 @@
 #include <vector>
 
 using palcas::ALL_ACTIONS;
-using palcas::TerminalRewards;
 using palcas::VehicleSnapshot;
 using palcas::rsu::Closings;
 using palcas::rsu::EventSets;
@@ -25,6 +25,7 @@ using palcas::rsu::RoadIndex;
 using palcas::rsu::StateNow;
 using palcas::rsu::TransitionBook;
 using palcas::rsu::VehicleOutcomes;
+using palcas_test::exactTerminalRewards;
 using palcas_test::expectThrowNaming;
 
 namespace {
@@ -57,16 +58,6 @@ RoadIndex index(const std::vector<VehicleSnapshot>& road) {
 
 StateNow now(float tag, double reward) {
   return StateNow{palcas::nn::Vector::Constant(1, tag), ALL_ACTIONS, reward};
-}
-
-TerminalRewards amounts() {
-  TerminalRewards t;
-  t.collision_penalty = 10.0;
-  t.exit_taken_bonus = 2.0;
-  t.exit_missed_penalty = 8.0;
-  t.exit_missed_terminal = true;
-  t.merge_failed_penalty = 4.0;
-  return t;
 }
 
 }  // namespace
@@ -107,7 +98,7 @@ TEST(TransitionBook, ClosesInIdOrderWithTheTerminalRewards) {
   const PendingFates fates = book.sort(index(road), MemberColumns{{"a_member", 0}}, events);
   const std::unordered_map<std::string, StateNow> states = {{"a_member", now(10.0f, -0.5)},
                                                             {"d_handed_over", now(40.0f, -0.25)}};
-  const Closings c = book.close(fates, index(road), states, events, amounts(), false);
+  const Closings c = book.close(fates, index(road), states, events, exactTerminalRewards(), false);
   ASSERT_EQ(c.closures.size(), 4u);
   EXPECT_EQ(c.vanished, std::vector<std::string>{"e_vanished"});
   // member past its exit: its reward now - 8, terminal, s' = its state now
@@ -134,8 +125,9 @@ TEST(TransitionBook, ClosesInIdOrderWithTheTerminalRewards) {
   VehicleOutcomes late;
   late.teleported = {"e_vanished"};
   const EventSets late_events(late);
-  const Closings next = book.close(book.sort(RoadIndex{}, MemberColumns{}, late_events), RoadIndex{},
-                                   {}, late_events, amounts(), false);
+  const PendingFates none_on_road = book.sort(RoadIndex{}, MemberColumns{}, late_events);
+  const Closings next =
+      book.close(none_on_road, RoadIndex{}, {}, late_events, exactTerminalRewards(), false);
   ASSERT_EQ(next.closures.size(), 1u);
   EXPECT_EQ(next.closures[0].reward, -11.0);
   EXPECT_TRUE(next.closures[0].done);
@@ -151,7 +143,8 @@ TEST(TransitionBook, PeriodRewardIsTheMeanOfTheStepsAndNow) {
   const std::vector<VehicleSnapshot> road = {on("a", 2)};
   const EventSets none{VehicleOutcomes{}};
   const PendingFates fates = book.sort(index(road), MemberColumns{{"a", 0}}, none);
-  const Closings c = book.close(fates, index(road), {{"a", now(1.0f, -1.0)}}, none, amounts(), true);
+  const Closings c =
+      book.close(fates, index(road), {{"a", now(1.0f, -1.0)}}, none, exactTerminalRewards(), true);
   ASSERT_EQ(c.closures.size(), 1u);
   EXPECT_EQ(c.closures[0].reward, -1.0);  // (-0.5 - 1.5 - 1) / 3
 }
@@ -163,7 +156,7 @@ TEST(TransitionBook, RefusesWhatItCannotCloseNamingTheId) {
   const EventSets none{VehicleOutcomes{}};
   const PendingFates fates = book.sort(index(road), MemberColumns{{"a", 0}}, none);
   expectThrowNaming<std::invalid_argument>(
-      [&] { book.close(fates, index(road), {}, none, amounts(), false); }, "'a'");
+      [&] { book.close(fates, index(road), {}, none, exactTerminalRewards(), false); }, "'a'");
   expectThrowNaming<std::invalid_argument>([&] { book.addStepReward("a", INF); }, "'a'");
   expectThrowNaming<std::invalid_argument>([&] { book.advance({"b"}, {}); }, "'b'");
   expectThrowNaming<std::out_of_range>([&] { book.decisionOf("b"); }, "'b'");
