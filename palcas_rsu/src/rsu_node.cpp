@@ -37,6 +37,21 @@ void requireEvalWeights(const RsuNodeOptions& o) {
                              "checkpoints/ folder, e.g. policies/palcas/checkpoints)");
 }
 
+/// When the node decides, learns, ticks the federation client and checkpoints.
+RsuScheduleOptions scheduleOf(const RsuNodeOptions& o) {
+  RsuScheduleOptions s;
+  s.decision_period_steps = o.decision_period_steps;
+  s.train = o.controller.train;
+  s.reward_over_period = o.controller.reward_over_period;
+  s.learner_thread = o.learner_thread;
+  s.checkpoint_every_decisions = o.checkpoint_every_decisions;
+  s.checkpoint_dir_set = !o.checkpoint_dir.empty();
+  // In training the federation client exists exactly when federation is on
+  // (loadInitialModel); in eval the schedule never ticks it.
+  s.federation = o.federation;
+  return s;
+}
+
 /// The node's options with what they leave to the bridge's road filled in from it (the
 /// bridge sets it before opening registration; an RSU may start first, so wait for it).
 RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
@@ -58,6 +73,7 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), private_nh_(private_nh), options_(loadOptionsOnTheRoad(nh_, private_nh_)),
       controller_(std::make_unique<RsuController>(options_.controller)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
+      schedule_(scheduleOf(options_)),
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s),
       learning_log_(options_.checkpoint_dir.empty() ? "" : (fs::path(checkpointDir()) / "learning.csv").string(),
                     options_.controller.rsu_id, options_.controller.train ? "train" : "eval") {
@@ -244,12 +260,12 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     i2i_in_flight_.clear();
   }
   last_state_step_ = msg->step;
-  if (msg->step % static_cast<std::uint64_t>(options_.decision_period_steps) == 0) {
+  if (schedule_.decidesAt(msg->step)) {
     decide(*msg, received);
     return;
   }
   answerEmpty(*msg, received);
-  const bool observe = options_.controller.train && options_.controller.reward_over_period;
+  const bool observe = schedule_.observesBetweenDecisions();
   if (observe || uplink_) {
     try {
       const RoadSnapshot road = heard(*msg);  // the uplink hears every step
@@ -259,10 +275,6 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
                          static_cast<unsigned long>(msg->step), e.what());
     }
   }
-}
-
-void RsuNode::joinLearner() {
-  if (learner_.valid()) learner_.get();  // rethrows what learn() threw
 }
 
 void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
@@ -282,84 +294,98 @@ void RsuNode::publishAdvisories(palcas_msgs::AdvisoryArray& out) {
 }
 
 void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
-  const RsuControllerOptions& c = options_.controller;
   const double now_s = msg.header.stamp.toSec();
-  palcas_msgs::AdvisoryArray out;
-  out.header = msg.header;
-  out.step = msg.step;
-  out.rsu_id = c.rsu_id;
+  schedule_.finishLearning();  // rethrows what learn() threw; the controller is ours again
+  GlobalDensities global;
   DecisionOutput decision;
-  joinLearner();
   try {
-    const RoadSnapshot snapshot = heard(msg);
-    for (const palcas_msgs::ClusterState& m : i2i_in_flight_.release(msg.step)) {
-      try {
-        peers_.update(m.cluster_index, m.rsu_id, m.density_veh_per_km, m.header.stamp.toSec());
-      } catch (const std::invalid_argument& e) {
-        ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
-      }
-    }
-    // The own density is not known before deciding; the state builder takes the global
-    // densities as given, so use the peers' view with the last own density.
-    const double unknown = std::numeric_limits<double>::quiet_NaN();
-    const GlobalDensities global = options_.i2i ? peers_.global(last_own_density_, now_s)
-                                                : GlobalDensities{unknown, unknown, unknown};
-    out.i2i_upstream_density_veh_per_km = global.upstream;
-    out.i2i_downstream_density_veh_per_km = global.downstream;
-    // Evaluating over the V2X channel, membership comes from what reached the RSU alone: the
-    // bridge's removal events race the states over ROS and would decide a stale vehicle's
-    // membership by arrival order. Training keeps them (its terminal rewards).
-    const VehicleOutcomes none;
-    decision = controller_->advise(snapshot, msg.step, now_s, global, uplink_ && !c.train ? none : outcomes_);
-    outcomes_.clear();
-    last_own_density_ = decision.cluster.density_veh_per_km;
+    decision = advise(msg, now_s, global);
   } catch (const std::invalid_argument& e) {
     // A malformed state: answer empty (CAVs keep their commands), say why, keep going.
-    ROS_ERROR_THROTTLE(5.0, "%s: step %lu not decided: %s", c.rsu_id.c_str(),
+    ROS_ERROR_THROTTLE(5.0, "%s: step %lu not decided: %s", options_.controller.rsu_id.c_str(),
                        static_cast<unsigned long>(msg.step), e.what());
     answerEmpty(msg, received);
     return;
   }
+  const float decision_ms = publishDecision(msg, decision, global, received);
+  const AfterDecision after = schedule_.decided();
+  if (after.learn_inline) controller_->learn();  // after publishing: the bridge need not wait
+  logDecision(msg.step, decision_ms);
+  if (after.federation_tick && federation_) federation_->onDecision(now_s);
+  if (after.checkpoint) checkpoint();
+  publishStatus(msg, now_s, decision_ms);
+  // Last: federation and checkpoints above saw the model as the decision used it.
+  if (after.learn_on_thread) schedule_.startLearning([this] { controller_->learn(); });
+}
+
+DecisionOutput RsuNode::advise(const palcas_msgs::VehicleStateArray& msg, double now_s, GlobalDensities& global) {
+  const RsuControllerOptions& c = options_.controller;
+  const RoadSnapshot snapshot = heard(msg);
+  for (const palcas_msgs::ClusterState& m : i2i_in_flight_.release(msg.step)) {
+    try {
+      peers_.update(m.cluster_index, m.rsu_id, m.density_veh_per_km, m.header.stamp.toSec());
+    } catch (const std::invalid_argument& e) {
+      ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
+    }
+  }
+  // The own density is not known before deciding; the state builder takes the global
+  // densities as given, so use the peers' view with the last own density.
+  const double unknown = std::numeric_limits<double>::quiet_NaN();
+  global = options_.i2i ? peers_.global(last_own_density_, now_s) : GlobalDensities{unknown, unknown, unknown};
+  // Evaluating over the V2X channel, membership comes from what reached the RSU alone: the
+  // bridge's removal events race the states over ROS and would decide a stale vehicle's
+  // membership by arrival order. Training keeps them (its terminal rewards).
+  const VehicleOutcomes none;
+  DecisionOutput decision = controller_->advise(snapshot, msg.step, now_s, global, uplink_ && !c.train ? none : outcomes_);
+  outcomes_.clear();
+  last_own_density_ = decision.cluster.density_veh_per_km;
+  return decision;
+}
+
+float RsuNode::publishDecision(const palcas_msgs::VehicleStateArray& msg, const DecisionOutput& decision,
+                               const GlobalDensities& global, const ros::WallTime& received) {
+  palcas_msgs::AdvisoryArray out;
+  out.header = msg.header;
+  out.step = msg.step;
+  out.rsu_id = options_.controller.rsu_id;
+  out.i2i_upstream_density_veh_per_km = global.upstream;
+  out.i2i_downstream_density_veh_per_km = global.downstream;
   for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
   publishAdvisories(out);
-  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, c, msg.step, now_s));
-  if (!options_.learner_thread)
-    controller_->learn();  // after publishing: the bridge need not wait for gradient steps
+  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, options_.controller, msg.step, decision.time_s));
+  return out.decision_ms;
+}
 
-  ++decisions_;
+void RsuNode::logDecision(std::uint64_t step, float decision_ms) {
   try {
-    learning_log_.addDecision(msg.step, controller_->stats(), out.decision_ms);
+    learning_log_.addDecision(step, controller_->stats(), decision_ms);
   } catch (const std::runtime_error& e) {
-    ROS_ERROR_THROTTLE(60.0, "%s: %s", c.rsu_id.c_str(), e.what());
+    ROS_ERROR_THROTTLE(60.0, "%s: %s", options_.controller.rsu_id.c_str(), e.what());
   }
-  if (c.train && federation_) federation_->onDecision(now_s);
-  if (c.train && options_.checkpoint_every_decisions > 0 && !options_.checkpoint_dir.empty() &&
-      decisions_ % static_cast<std::uint64_t>(options_.checkpoint_every_decisions) == 0)
-    checkpoint();
+}
 
+void RsuNode::publishStatus(const palcas_msgs::VehicleStateArray& msg, double now_s, float decision_ms) {
+  const RsuControllerOptions& c = options_.controller;
   StatusContext context;
   context.header = msg.header;
   context.step = msg.step;
   context.rsu_id = c.rsu_id;
   context.train = c.train;
-  context.decision_ms = out.decision_ms;
+  context.decision_ms = decision_ms;
   context.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
   context.federation_reachable = federation_ && federation_->reachable();
   const palcas_msgs::RsuStatus status = toStatusMsg(controller_->stats(), context);
   status_pub_.publish(status);
   last_status_ = status;
-  recent_decision_ms_.add(out.decision_ms);
+  recent_decision_ms_.add(decision_ms);
   diagnostics_.update();
-  // Last: federation and checkpoints above saw the model as the decision used it.
-  if (options_.learner_thread && c.train)
-    learner_ = std::async(std::launch::async, [this] { controller_->learn(); });
 }
 
 void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
   RsuHealthFacts f;
   f.last = last_status_;
-  f.decided = decisions_ > 0;
+  f.decided = schedule_.decisions() > 0;
   f.policy = policy_file_;
   f.i2i = options_.i2i && !options_.whole_road;
   f.federation = options_.federation;
@@ -419,7 +445,7 @@ void RsuNode::addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) c
 }
 
 void RsuNode::shutdown() {
-  joinLearner();
+  schedule_.finishLearning();
   endEpisodeLog();
   if (options_.controller.train && !options_.checkpoint_dir.empty()) {
     checkpoint();

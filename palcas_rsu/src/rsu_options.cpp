@@ -30,11 +30,12 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);
-  c.collision_penalty = p.number("rsu/collision_penalty", c.collision_penalty, 0.0, 1e9);
-  c.exit_taken_bonus = p.number("rsu/exit_taken_bonus", c.exit_taken_bonus, 0.0, 1e9);
-  c.exit_missed_penalty = p.number("rsu/exit_missed_penalty", c.exit_missed_penalty, 0.0, 1e9);
-  c.exit_missed_terminal = p.get<bool>("rsu/exit_missed_terminal", c.exit_missed_terminal);
-  c.merge_failed_penalty = p.number("rsu/merge_failed_penalty", c.merge_failed_penalty, 0.0, 1e9);
+  TerminalRewards& t = c.terminal;
+  t.collision_penalty = p.number("rsu/collision_penalty", t.collision_penalty, 0.0, 1e9);
+  t.exit_taken_bonus = p.number("rsu/exit_taken_bonus", t.exit_taken_bonus, 0.0, 1e9);
+  t.exit_missed_penalty = p.number("rsu/exit_missed_penalty", t.exit_missed_penalty, 0.0, 1e9);
+  t.exit_missed_terminal = p.get<bool>("rsu/exit_missed_terminal", t.exit_missed_terminal);
+  t.merge_failed_penalty = p.number("rsu/merge_failed_penalty", t.merge_failed_penalty, 0.0, 1e9);
   c.reward_over_period = p.get<bool>("rsu/reward_over_period", c.reward_over_period);
   o.learner_thread = p.get<bool>("rsu/learner_thread", o.learner_thread);
   o.decision_period_steps = p.integer("rsu/decision_period_steps", o.decision_period_steps, 1, 100000);

@@ -1,9 +1,9 @@
 #pragma once
 // The RSU node: a thin ROS shell around palcas_core's RsuController. Per bridge step it
-// answers the lockstep (an AdvisoryArray, empty between decisions); every
-// decision_period_steps it converts the state, calls the controller once for all its CAVs,
-// publishes the advisories, its ClusterState (I2I) and its RsuStatus; in train mode it runs
-// the federation exchange without blocking the advisories.
+// answers the lockstep (an AdvisoryArray, empty between decisions); at the decision steps
+// of its RsuSchedule it converts the state, calls the controller once for all its CAVs,
+// publishes the advisories, its ClusterState (I2I) and its RsuStatus, then does what the
+// schedule says follows (learning, the federation client's tick, checkpoints).
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <palcas_core/common/message_auth.h>
@@ -17,7 +17,6 @@
 #include <palcas_msgs/VehicleStateArray.h>
 #include <ros/ros.h>
 
-#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -27,6 +26,7 @@
 #include "palcas_rsu/peer_states.h"
 #include "palcas_rsu/rsu_diagnostics.h"
 #include "palcas_rsu/rsu_options.h"
+#include "palcas_rsu/rsu_schedule.h"
 
 namespace palcas::rsu {
 
@@ -45,6 +45,17 @@ class RsuNode {
   void onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg);
   void onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg);
   void decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
+  /// The controller's advice on what this RSU heard at the state's step, with the I2I
+  /// densities it used (`global`). @throws std::invalid_argument for a malformed state.
+  DecisionOutput advise(const palcas_msgs::VehicleStateArray& msg, double now_s, GlobalDensities& global);
+  /// Publishes a decision's advisories (and its ClusterState with I2I); returns the
+  /// decision's wall time [ms].
+  float publishDecision(const palcas_msgs::VehicleStateArray& msg, const DecisionOutput& decision,
+                        const GlobalDensities& global, const ros::WallTime& received);
+  /// The decision's row of the learning log (errors logged, not thrown).
+  void logDecision(std::uint64_t step, float decision_ms);
+  /// The decision's RsuStatus (msg_conversion's toStatusMsg) and the diagnostics.
+  void publishStatus(const palcas_msgs::VehicleStateArray& msg, double now_s, float decision_ms);
   void answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
   void waitForPeers();
   void registerWithBridge();
@@ -64,10 +75,10 @@ class RsuNode {
   RsuNodeOptions options_;
   std::unique_ptr<RsuController> controller_;
   std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: nothing signed or checked
-  // The running learn() of the last decision (learner_thread); joinLearner() before any
-  // other use of controller_.
-  std::future<void> learner_;
-  void joinLearner();
+  // When to decide, observe, learn (and the learner thread: finishLearning() before any
+  // other use of controller_), tick the federation and checkpoint. After controller_: it
+  // joins a running learner before the controller goes.
+  RsuSchedule schedule_;
   PeerStates peers_;
   VehicleOutcomes outcomes_;
   // The V2X channel on this RSU's side (options_.v2x.enabled): built at the first state
@@ -93,7 +104,6 @@ class RsuNode {
   std::unique_ptr<RosFederationTransport> transport_;
   std::unique_ptr<FederationClient> federation_;
 
-  std::uint64_t decisions_ = 0;
   LearningLog learning_log_;  ///< <checkpoint_dir>/<rsu_id>/learning.csv, a row per episode
   /// This zone's density at the previous decision: the "own" global density (veh/km).
   double last_own_density_ = std::numeric_limits<double>::quiet_NaN();

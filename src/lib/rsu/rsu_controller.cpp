@@ -1,11 +1,10 @@
-// RsuController: options, membership, decisions, transitions and gradient steps.
+// RsuController: options, membership, decisions, the states and rewards of the transitions
+// its TransitionBook closes (transition_book.cpp), storing them, gradient steps.
 // Checkpoints and federation: rsu_controller_io.cpp. Reasons: src/doc/rsu.md.
 #include "palcas_core/rsu/rsu_controller.h"
 
-#include <algorithm>
 #include <cmath>
-#include <set>
-#include <sstream>
+#include <map>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -45,14 +44,7 @@ void RsuControllerOptions::validate() const {
   require(num_lanes >= 1, "num_lanes", num_lanes, "must be >= 1");
   require(std::isfinite(gradient_steps_per_decision) && gradient_steps_per_decision >= 0.0,
           "gradient_steps_per_decision", gradient_steps_per_decision, "must be finite and >= 0");
-  require(std::isfinite(collision_penalty) && collision_penalty >= 0.0, "collision_penalty",
-          collision_penalty, "must be finite and >= 0 (it is subtracted)");
-  require(std::isfinite(exit_taken_bonus) && exit_taken_bonus >= 0.0, "exit_taken_bonus",
-          exit_taken_bonus, "must be finite and >= 0 (it is added)");
-  require(std::isfinite(exit_missed_penalty) && exit_missed_penalty >= 0.0, "exit_missed_penalty",
-          exit_missed_penalty, "must be finite and >= 0 (it is subtracted)");
-  require(std::isfinite(merge_failed_penalty) && merge_failed_penalty >= 0.0,
-          "merge_failed_penalty", merge_failed_penalty, "must be finite and >= 0 (it is subtracted)");
+  nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
   nested("scales", [&] { validateScales(scales); });
   nested("pdqn", [&] { pdqn.validate(); });
@@ -62,46 +54,14 @@ void RsuControllerOptions::validate() const {
               " + num_lanes = " + std::to_string(needed));
 }
 
-void VehicleOutcomes::add(metrics::VehicleEventKind kind, const std::string& id) {
-  using K = metrics::VehicleEventKind;
-  switch (kind) {
-    case K::kCollision: collided.push_back(id); break;
-    case K::kTeleport: teleported.push_back(id); break;
-    case K::kArrived: arrived.push_back(id); break;
-    case K::kExitOk: exited.push_back(id); break;
-    case K::kExitMissed: exit_missed.push_back(id); break;
-    case K::kMergeFailed: merge_failed.push_back(id); break;
-    default: break;  // departed / merge-ok events end nothing
-  }
-}
-
-void VehicleOutcomes::clear() {
-  collided.clear();
-  teleported.clear();
-  arrived.clear();
-  exited.clear();
-  exit_missed.clear();
-  merge_failed.clear();
-}
-
-/// One transition to store: (pending s, a) -> (reward, s', done).
-struct Closure {
-  std::string id;
-  nn::Vector next_state;
-  ActionMask next_valid_actions = ALL_ACTIONS;  ///< possibleActions of the CAV in s'
-  double reward = 0.0;
-  bool done = false;
-};
-
 struct RsuController::Observation {
   ClusterSummary cluster;
   std::vector<std::string> member_ids;
   std::vector<int> member_lanes;       // paper lane of each member (0 = acceleration lane)
   nn::Matrix member_states;            // state_size x members
   std::vector<double> member_rewards;  // train mode only
-  std::vector<Closure> closures;       // train mode only, ordered by id
-  std::vector<std::string> vanished;   // pending CAVs gone without an event (to limbo)
   std::vector<double> member_exit_m;   // distance to exit of each member (train mode)
+  Closings closings;                   // train mode only: closures in id order, to limbo
 };
 
 namespace {
@@ -128,8 +88,8 @@ bool RsuController::isMember(const VehicleSnapshot& v) const {
 
 bool RsuController::federationDue() const {
   const uint64_t steps = agent_.gradientSteps();
-  return options_.federation_interval_steps > 0 && steps >= grad_steps_at_round_ &&
-         steps - grad_steps_at_round_ >= options_.federation_interval_steps;
+  return options_.federation_interval_steps > 0 && steps >= counters_.grad_steps_at_round &&
+         steps - counters_.grad_steps_at_round >= options_.federation_interval_steps;
 }
 
 namespace {
@@ -156,6 +116,31 @@ std::vector<double> rewardsOf(const NeighbourFinder& finder, const std::vector<s
 
 }  // namespace
 
+// s', its valid actions and the reward now of each pending CAV still on the road: the
+// members' as decided, the others' (handed over, mostly) in one more batch, all with this
+// zone's statistics (src/doc/rsu.md, "whose statistics for a CAV outside the zone").
+std::unordered_map<std::string, StateNow> RsuController::statesNow(
+    const Observation& obs, const MemberColumns& columns, const PendingFates& fates,
+    const RoadIndex& road, const NeighbourFinder& finder, const ClusterStats& stats,
+    const GlobalDensities& global) const {
+  const int lanes = options_.num_lanes;
+  std::unordered_map<std::string, StateNow> now;
+  for (const std::string& id : fates.members) {
+    const size_t col = columns.at(id);
+    now[id] = StateNow{obs.member_states.col(static_cast<nn::Index>(col)),
+                       possibleActions(obs.member_lanes[col], lanes), obs.member_rewards[col]};
+  }
+  if (fates.outside_zone.empty()) return now;
+  const nn::Matrix states = builder_.buildStates(finder, fates.outside_zone, stats, global);
+  const std::vector<double> rewards = rewardsOf(finder, fates.outside_zone, stats, options_.reward);
+  for (size_t i = 0; i < fates.outside_zone.size(); ++i) {
+    const std::string& id = fates.outside_zone[i];
+    now[id] = StateNow{states.col(static_cast<nn::Index>(i)),
+                       possibleActions(road.at(id)->lane, lanes), rewards[i]};
+  }
+  return now;
+}
+
 RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
                                                   const GlobalDensities& global,
                                                   const VehicleOutcomes& outcomes) const {
@@ -164,20 +149,12 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   obs.cluster = computeClusterSummary(snapshot, options_.x_start_m, options_.x_end_m,
                                       options_.reward.v_bar_max);
   const ClusterStats stats = obs.cluster.toClusterStats();
-
-  // Vehicles named by a removal event are gone even if this snapshot still lists them.
-  std::set<std::string> removed, penalised;
-  for (const auto* list : {&outcomes.collided, &outcomes.teleported}) {
-    removed.insert(list->begin(), list->end());
-    penalised.insert(list->begin(), list->end());
-  }
-  for (const auto* list : {&outcomes.arrived, &outcomes.exited})
-    removed.insert(list->begin(), list->end());
-
-  std::unordered_map<std::string, const VehicleSnapshot*> on_road;
+  const EventSets events(outcomes);
+  RoadIndex road;
   for (const VehicleSnapshot& v : snapshot.vehicles) {
-    on_road.emplace(v.id, &v);
-    if (isMember(v) && removed.count(v.id) == 0) {
+    road.emplace(v.id, &v);
+    // Vehicles named by a removal event are gone even if this snapshot still lists them.
+    if (isMember(v) && events.removed.count(v.id) == 0) {
       obs.member_ids.push_back(v.id);
       obs.member_lanes.push_back(v.lane);
       obs.member_exit_m.push_back(v.distance_to_exit_m);
@@ -188,87 +165,12 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   if (!options_.train) return obs;
   obs.member_rewards = rewardsOf(finder, obs.member_ids, stats, options_.reward);
 
-  std::unordered_map<std::string, int> member_column;
-  for (size_t i = 0; i < obs.member_ids.size(); ++i)
-    member_column.emplace(obs.member_ids[i], static_cast<int>(i));
-  const std::set<std::string> exited(outcomes.exited.begin(), outcomes.exited.end());
-  const std::set<std::string> missed(outcomes.exit_missed.begin(), outcomes.exit_missed.end());
-  const std::set<std::string> merge_failed(outcomes.merge_failed.begin(), outcomes.merge_failed.end());
-  const bool over_period = options_.reward_over_period;
-
-  // Terminal outcomes read from the road itself, so a transition does not depend on
-  // whether the event of the same step arrived before the states (separate topics).
-  auto passedExit = [&](const Pending& p, const VehicleSnapshot& v) {
-    return missed.count(v.id) > 0 ||
-           (std::isfinite(p.distance_to_exit_m) && std::isinf(v.distance_to_exit_m) && v.lane >= 1);
-  };
-  auto onOffRamp = [](const VehicleSnapshot& v) { return v.lane == 0 && !v.on_accel_lane; };
-  auto applyOutcomePenalties = [&](Closure& c, const Pending& p, const VehicleSnapshot& v) {
-    if (merge_failed.count(c.id) > 0) c.reward -= options_.merge_failed_penalty;
-    if (passedExit(p, v)) {
-      c.reward -= options_.exit_missed_penalty;
-      if (options_.exit_missed_terminal) c.done = true;
-    }
-  };
-  // Closes a pending CAV that left the road: collision / teleport pay, an exit earns.
-  // Terminal: s' = s, so the mask is that of s (done zeroes the bootstrap; the mask of s'
-  // anyway keeps every target what it was when the agent decoded it, bit for bit).
-  auto closeRemoved = [&](const std::string& id, const Pending& p) {
-    Closure c{id, p.state, p.valid_actions, p.lastReward(), true};
-    if (penalised.count(id) > 0) c.reward -= options_.collision_penalty;
-    if (exited.count(id) > 0) c.reward += options_.exit_taken_bonus;
-    if (merge_failed.count(id) > 0) c.reward -= options_.merge_failed_penalty;
-    return c;
-  };
-
-  // Last decision's vanished CAVs: their events have arrived by now.
-  for (const auto& [id, p] : limbo_) obs.closures.push_back(closeRemoved(id, p));
-
-  std::vector<std::string> elsewhere;  // pending CAVs on the road but not members now
-  for (const auto& [id, pending] : pending_) {
-    const auto member = member_column.find(id);
-    const auto road = on_road.find(id);
-    if (removed.count(id) > 0) {
-      obs.closures.push_back(closeRemoved(id, pending));
-    } else if (member != member_column.end()) {
-      const size_t col = static_cast<size_t>(member->second);
-      Closure c{id, obs.member_states.col(member->second),
-                possibleActions(obs.member_lanes[col], options_.num_lanes),
-                pending.periodReward(obs.member_rewards[col], over_period), false};
-      applyOutcomePenalties(c, pending, *road->second);
-      obs.closures.push_back(std::move(c));
-    } else if (road != on_road.end() && onOffRamp(*road->second)) {
-      // On an off-ramp: a controlled CAV only ever leaves by its own (the bridge commits
-      // the exit from lane 1), so this is the exit taken.
-      Closure c{id, pending.state, pending.valid_actions,
-                pending.lastReward() + options_.exit_taken_bonus, true};
-      obs.closures.push_back(std::move(c));
-    } else if (road != on_road.end()) {
-      elsewhere.push_back(id);  // filled below in one batch
-    } else {
-      obs.vanished.push_back(id);  // no event yet: closed at the next decision
-    }
-  }
-  if (!elsewhere.empty()) {
-    // Handed over (eligible, outside the zone): the value continues under the next RSU,
-    // which shares the federated model -> done = false. Reward and s' use this cluster's
-    // statistics.
-    const nn::Matrix states = builder_.buildStates(finder, elsewhere, stats, global);
-    const std::vector<double> rewards = rewardsOf(finder, elsewhere, stats, options_.reward);
-    for (size_t i = 0; i < elsewhere.size(); ++i) {
-      const VehicleSnapshot& v = *on_road.at(elsewhere[i]);
-      const Pending& p = pending_.at(elsewhere[i]);
-      const bool handed_over = v.is_cav && (v.lane >= 1 || v.on_accel_lane);
-      Closure c{elsewhere[i], states.col(static_cast<nn::Index>(i)),
-                possibleActions(v.lane, options_.num_lanes),
-                p.periodReward(rewards[i], over_period), !handed_over};
-      applyOutcomePenalties(c, p, v);
-      obs.closures.push_back(std::move(c));
-    }
-  }
-  // Keep the id order so the replay order does not depend on the case mix.
-  std::sort(obs.closures.begin(), obs.closures.end(),
-            [](const Closure& a, const Closure& b) { return a.id < b.id; });
+  MemberColumns columns;
+  for (size_t i = 0; i < obs.member_ids.size(); ++i) columns.emplace(obs.member_ids[i], i);
+  const PendingFates fates = book_.sort(road, columns, events);
+  const auto now = statesNow(obs, columns, fates, road, finder, stats, global);
+  obs.closings =
+      book_.close(fates, road, now, events, options_.terminal, options_.reward_over_period);
   return obs;
 }
 
@@ -312,8 +214,7 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   // ---- commit: nothing below throws on validated input ----
   if (have_last_step_ && step <= last_step_) {  // the bridge restarted: a new episode
     endEpisode();
-    obs.closures.clear();
-    obs.vanished.clear();
+    obs.closings = Closings{};
   }
   have_last_step_ = true;
   last_step_ = step;
@@ -321,14 +222,14 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   DecisionOutput out;
   out.step = step;
   out.time_s = time_s;
-  out.model_version = model_version_;
+  out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
   if (!obs.member_ids.empty()) agent_.act(obs.member_states, options_.train, decisions);
   for (size_t i = 0; i < decisions.size(); ++i)
     decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);
 
-  stats_.decisions++;
+  counters_.decisions++;
   stats_.member_count = static_cast<uint32_t>(obs.member_ids.size());
   stats_.action_counts.fill(0);
   out.advisories.reserve(decisions.size());
@@ -337,56 +238,53 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
     stats_.action_counts[static_cast<size_t>(decisions[i].action)]++;
   }
   if (options_.train) {
-    closePending(obs);
-    limbo_.clear();
-    for (const std::string& id : obs.vanished) limbo_[id] = pending_.at(id);
-    pending_.clear();
+    storeClosures(obs.closings.closures);
+    std::map<std::string, PendingDecision> decided;
     for (size_t i = 0; i < decisions.size(); ++i) {
-      Pending p;
+      PendingDecision& p = decided[obs.member_ids[i]];
       p.state = obs.member_states.col(static_cast<nn::Index>(i));
       p.valid_actions = possibleActions(obs.member_lanes[i], options_.num_lanes);
       p.decision = decisions[i];
       p.reward = obs.member_rewards[i];
       p.distance_to_exit_m = obs.member_exit_m[i];
-      pending_[obs.member_ids[i]] = std::move(p);
     }
+    book_.advance(obs.closings.vanished, std::move(decided));
   }
   return out;
 }
 
-void RsuController::closePending(const Observation& obs) {
+void RsuController::storeClosures(const std::vector<Closure>& closures) {
   double sum = 0.0;
-  for (const Closure& c : obs.closures) {
-    const auto in_limbo = limbo_.find(c.id);
-    const Pending& p = in_limbo != limbo_.end() ? in_limbo->second : pending_.at(c.id);
+  for (const Closure& c : closures) {
+    const PendingDecision& p = book_.decisionOf(c.id);
     agent_.remember(p.state, p.decision, static_cast<float>(c.reward), c.next_state,
                     c.next_valid_actions, c.done);
     sum += c.reward;
   }
   // R_k = sum over the CAVs of the per-CAV reward (paper "Reward Function").
-  stats_.transitions_closed = static_cast<uint32_t>(obs.closures.size());
+  stats_.transitions_closed = static_cast<uint32_t>(closures.size());
   stats_.sum_reward = sum;
-  stats_.mean_reward = obs.closures.empty() ? std::nan("") : sum / obs.closures.size();
-  stats_.transitions_stored += obs.closures.size();
-  samples_since_federation_ += obs.closures.size();
+  stats_.mean_reward = closures.empty() ? std::nan("") : sum / closures.size();
+  counters_.transitions_stored += closures.size();
+  counters_.samples_since_federation += closures.size();
 }
 
 void RsuController::runGradientSteps() {
   // Credit is earned only while the replay holds a batch, so a long warm-up does not
   // turn into a burst of updates later.
   if (!agent_.canUpdate()) return;
-  gradient_credit_ += options_.gradient_steps_per_decision;
-  while (gradient_credit_ >= 1.0 - CREDIT_EPSILON) {
+  counters_.gradient_credit += options_.gradient_steps_per_decision;
+  while (counters_.gradient_credit >= 1.0 - CREDIT_EPSILON) {
     const UpdateStats u = agent_.update();
     stats_.q_loss = u.q_loss;
     stats_.param_loss = u.param_loss;
-    gradient_credit_ -= 1.0;
+    counters_.gradient_credit -= 1.0;
   }
-  if (gradient_credit_ < 0.0) gradient_credit_ = 0.0;  // absorb the tolerance
+  if (counters_.gradient_credit < 0.0) counters_.gradient_credit = 0.0;  // absorb the tolerance
 }
 
 void RsuController::observeStep(const RoadSnapshot& snapshot) {
-  if (!options_.train || !options_.reward_over_period || pending_.empty()) return;
+  if (!options_.train || !options_.reward_over_period || book_.empty()) return;
   if (snapshot.num_lanes != options_.num_lanes)
     throw std::invalid_argument("RsuController::observeStep: snapshot num_lanes = " +
                                 std::to_string(snapshot.num_lanes) + ", this RSU has " +
@@ -397,19 +295,13 @@ void RsuController::observeStep(const RoadSnapshot& snapshot) {
                                  .toClusterStats();
   std::vector<std::string> ids;
   for (const VehicleSnapshot& v : snapshot.vehicles)
-    if (pending_.count(v.id) > 0 && (v.lane >= 1 || v.on_accel_lane)) ids.push_back(v.id);
+    if (book_.isPending(v.id) && (v.lane >= 1 || v.on_accel_lane)) ids.push_back(v.id);
   const std::vector<double> rewards = rewardsOf(finder, ids, stats, options_.reward);
-  for (size_t i = 0; i < ids.size(); ++i) {
-    Pending& p = pending_.at(ids[i]);
-    p.period_reward_sum += rewards[i];
-    p.period_steps++;
-  }
+  for (size_t i = 0; i < ids.size(); ++i) book_.addStepReward(ids[i], rewards[i]);
 }
 
 void RsuController::endEpisode() {
-  stats_.pending_dropped += pending_.size() + limbo_.size();
-  pending_.clear();
-  limbo_.clear();
+  stats_.pending_dropped += book_.dropAll();
   have_last_step_ = false;
 }
 
@@ -417,9 +309,11 @@ RsuControllerStats RsuController::stats() const {
   RsuControllerStats s = stats_;
   s.epsilon = agent_.epsilon();
   s.gradient_steps = agent_.gradientSteps();
-  s.samples_since_federation = samples_since_federation_;
-  s.model_version = model_version_;
-  s.federation_round = federation_round_;
+  s.decisions = counters_.decisions;
+  s.samples_since_federation = counters_.samples_since_federation;
+  s.transitions_stored = counters_.transitions_stored;
+  s.model_version = counters_.model_version;
+  s.federation_round = counters_.federation_round;
   return s;
 }
 

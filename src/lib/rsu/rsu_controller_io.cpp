@@ -1,4 +1,5 @@
 // RsuController: federation model exchange and checkpoints. Reasons: src/doc/rsu.md.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 
 #include "palcas_core/common/atomic_file.h"
 #include "palcas_core/rsu/rsu_controller.h"
@@ -23,18 +25,35 @@ constexpr const char* CONTROLLER_FILE = "controller.txt";
 constexpr const char* AGENT_FILE = "agent.ckpt";
 constexpr const char* CONTROLLER_MAGIC = "palcas_rsu_controller 1";
 
-// Counters of the controller file, every key required exactly once.
-struct ControllerCounters {
+// Everything controller.txt holds: the counters, and what ties the file to an RSU, an agent
+// layout and one write.
+struct ControllerFile : ControllerCounters {
   std::string rsu_id;
   uint64_t layout_checksum = 0;
-  uint64_t samples_since_federation = 0;
-  double gradient_credit = 0.0;
-  uint64_t grad_steps_at_round = 0;
-  uint64_t model_version = 0;
-  uint64_t federation_round = 0;
-  uint64_t transitions_stored = 0;
-  uint64_t decisions = 0;
   uint64_t checkpoint_id = 0;  ///< random per write; 0 in files from before it existed
+};
+
+// The one list of controller.txt's keys, in the order they are written (byte-compatible
+// with every file written before this table: keep the order). Each is required exactly
+// once when read, but checkpoint_id (absent from older files).
+using FileMember = std::variant<std::string ControllerFile::*, uint64_t ControllerFile::*,
+                                uint32_t ControllerFile::*, double ControllerFile::*>;
+struct FileKey {
+  const char* name;
+  FileMember member;
+  bool required;
+};
+const FileKey FILE_KEYS[] = {
+    {"rsu_id", &ControllerFile::rsu_id, true},
+    {"layout_checksum", &ControllerFile::layout_checksum, true},
+    {"samples_since_federation", &ControllerFile::samples_since_federation, true},
+    {"gradient_credit", &ControllerFile::gradient_credit, true},
+    {"grad_steps_at_round", &ControllerFile::grad_steps_at_round, true},
+    {"model_version", &ControllerFile::model_version, true},
+    {"federation_round", &ControllerFile::federation_round, true},
+    {"transitions_stored", &ControllerFile::transitions_stored, true},
+    {"decisions", &ControllerFile::decisions, true},
+    {"checkpoint_id", &ControllerFile::checkpoint_id, false},
 };
 
 std::string joinPath(const std::string& dir, const char* file) {
@@ -67,7 +86,25 @@ double parseCredit(const std::string& text, const std::string& where) {
   return v;
 }
 
-ControllerCounters readCounters(const std::string& path) {
+// Sets the member of `key` from its text `value` (`where`: file and key, for the errors).
+void parseValue(const FileKey& key, const std::string& value, const std::string& path,
+                const std::string& where, ControllerFile& file) {
+  struct Parse {
+    const std::string &value, &path, &where;
+    ControllerFile& file;
+    void operator()(std::string ControllerFile::*m) const { file.*m = value; }
+    void operator()(uint64_t ControllerFile::*m) const { file.*m = parseU64(value, where); }
+    void operator()(uint32_t ControllerFile::*m) const {
+      const uint64_t v = parseU64(value, where);
+      if (v > UINT32_MAX) throw std::runtime_error(path + ": version or round beyond 32 bits");
+      file.*m = static_cast<uint32_t>(v);
+    }
+    void operator()(double ControllerFile::*m) const { file.*m = parseCredit(value, where); }
+  };
+  std::visit(Parse{value, path, where, file}, key.member);
+}
+
+ControllerFile readControllerFile(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot read RSU checkpoint file " + path);
   std::string line;
@@ -84,45 +121,40 @@ ControllerCounters readCounters(const std::string& path) {
       throw std::runtime_error(path + ":" + std::to_string(number) + ": duplicate key '" + key +
                                "'");
   }
-  ControllerCounters c;
-  const std::map<std::string, uint64_t*> numbers = {
-      {"layout_checksum", &c.layout_checksum},
-      {"samples_since_federation", &c.samples_since_federation},
-      {"grad_steps_at_round", &c.grad_steps_at_round},
-      {"model_version", &c.model_version},
-      {"federation_round", &c.federation_round},
-      {"transitions_stored", &c.transitions_stored},
-      {"decisions", &c.decisions}};
-  for (const auto& [key, value] : kv) {
-    const std::string where = path + ": key '" + key + "'";
-    if (key == "rsu_id") c.rsu_id = value;
-    else if (key == "checkpoint_id") c.checkpoint_id = parseU64(value, where);  // optional
-    else if (key == "gradient_credit") c.gradient_credit = parseCredit(value, where);
-    else if (numbers.count(key) > 0) *numbers.at(key) = parseU64(value, where);
-    else throw std::runtime_error(path + ": unknown key '" + key + "'");
+  ControllerFile file;
+  for (const auto& [name, value] : kv) {
+    const auto key = std::find_if(std::begin(FILE_KEYS), std::end(FILE_KEYS),
+                                  [&name = name](const FileKey& k) { return name == k.name; });
+    if (key == std::end(FILE_KEYS)) throw std::runtime_error(path + ": unknown key '" + name + "'");
+    parseValue(*key, value, path, path + ": key '" + name + "'", file);
   }
-  for (const char* key : {"rsu_id", "gradient_credit"})
-    if (kv.count(key) == 0) throw std::runtime_error(path + ": missing key '" + key + "'");
-  for (const auto& entry : numbers)
-    if (kv.count(entry.first) == 0)
-      throw std::runtime_error(path + ": missing key '" + entry.first + "'");
-  for (uint64_t v : {c.model_version, c.federation_round})
-    if (v > UINT32_MAX) throw std::runtime_error(path + ": version or round beyond 32 bits");
-  return c;
+  for (const FileKey& key : FILE_KEYS)
+    if (key.required && kv.count(key.name) == 0)
+      throw std::runtime_error(path + ": missing key '" + key.name + "'");
+  return file;
+}
+
+std::string formatControllerFile(const ControllerFile& file) {
+  std::ostringstream text;
+  text.precision(17);  // the credit round-trips exactly
+  text << CONTROLLER_MAGIC << "\n";
+  for (const FileKey& key : FILE_KEYS)
+    std::visit([&](auto member) { text << key.name << " " << file.*member << "\n"; }, key.member);
+  return text.str();
 }
 
 }  // namespace
 
 void RsuController::loadGlobalModel(const ModelBlob& blob, uint32_t version) {
-  if (version < model_version_)
+  if (version < counters_.model_version)
     throw std::invalid_argument("RsuController::loadGlobalModel: version " +
                                 std::to_string(version) + " is older than the current " +
-                                std::to_string(model_version_));
+                                std::to_string(counters_.model_version));
   agent_.importModel(blob);  // throws std::invalid_argument, agent untouched
-  model_version_ = version;
-  ++federation_round_;
-  samples_since_federation_ = 0;
-  grad_steps_at_round_ = agent_.gradientSteps();
+  counters_.model_version = version;
+  ++counters_.federation_round;
+  counters_.samples_since_federation = 0;
+  counters_.grad_steps_at_round = agent_.gradientSteps();
 }
 
 void RsuController::loadPolicy(const std::string& path) { agent_.loadModel(path); }
@@ -136,38 +168,31 @@ void RsuController::saveCheckpoint(const std::string& dir) const {
   // another writer's id there and must not overwrite newer state.
   const std::string counters_path = joinPath(dir, CONTROLLER_FILE);
   if (std::filesystem::exists(counters_path)) {
-    const ControllerCounters on_disk = readCounters(counters_path);
+    const ControllerFile on_disk = readControllerFile(counters_path);
     if (!checkpoint_owned_ || on_disk.checkpoint_id != checkpoint_seen_id_)
       throw std::runtime_error(
           dir + " holds a checkpoint this process neither loaded nor wrote (decisions " +
-          std::to_string(on_disk.decisions) + ", this process " + std::to_string(stats_.decisions) +
+          std::to_string(on_disk.decisions) + ", this process " +
+          std::to_string(counters_.decisions) +
           "): another process owns it, so it is not overwritten");
   }
   static thread_local std::mt19937_64 ids{std::random_device{}()};
   uint64_t id = 0;
   while (id == 0) id = ids();
   agent_.saveCheckpoint(joinPath(dir, AGENT_FILE));  // atomic (temp file + rename)
-  std::ostringstream text;
-  text.precision(17);  // the credit round-trips exactly
-  text << CONTROLLER_MAGIC << "\n"
-       << "rsu_id " << options_.rsu_id << "\n"
-       << "layout_checksum " << agent_.layoutChecksum() << "\n"
-       << "samples_since_federation " << samples_since_federation_ << "\n"
-       << "gradient_credit " << gradient_credit_ << "\n"
-       << "grad_steps_at_round " << grad_steps_at_round_ << "\n"
-       << "model_version " << model_version_ << "\n"
-       << "federation_round " << federation_round_ << "\n"
-       << "transitions_stored " << stats_.transitions_stored << "\n"
-       << "decisions " << stats_.decisions << "\n"
-       << "checkpoint_id " << id << "\n";
-  writeFileAtomically(counters_path, text.str());
+  ControllerFile file;
+  static_cast<ControllerCounters&>(file) = counters_;
+  file.rsu_id = options_.rsu_id;
+  file.layout_checksum = agent_.layoutChecksum();
+  file.checkpoint_id = id;
+  writeFileAtomically(counters_path, formatControllerFile(file));
   checkpoint_owned_ = true;
   checkpoint_seen_id_ = id;
 }
 
 void RsuController::loadCheckpoint(const std::string& dir) {
   const std::string path = joinPath(dir, CONTROLLER_FILE);
-  const ControllerCounters c = readCounters(path);  // every check before any change
+  const ControllerFile c = readControllerFile(path);  // every check before any change
   if (c.rsu_id != options_.rsu_id)
     throw std::runtime_error(path + ": written by RSU '" + c.rsu_id + "', this is '" +
                              options_.rsu_id + "'");
@@ -185,14 +210,8 @@ void RsuController::loadCheckpoint(const std::string& dir) {
   };
   // throws std::runtime_error, agent untouched
   agent_.loadCheckpoint(joinPath(dir, AGENT_FILE), mask_of_next_state);
-  samples_since_federation_ = c.samples_since_federation;
-  gradient_credit_ = c.gradient_credit;
-  grad_steps_at_round_ = c.grad_steps_at_round;
-  model_version_ = static_cast<uint32_t>(c.model_version);
-  federation_round_ = static_cast<uint32_t>(c.federation_round);
-  stats_.transitions_stored = c.transitions_stored;
-  stats_.decisions = c.decisions;
-  pending_.clear();  // they belong to the run that wrote the checkpoint
+  counters_ = c;  // the counters part of the file
+  book_.dropPending();  // they belong to the run that wrote the checkpoint
   have_last_step_ = false;
   checkpoint_owned_ = true;  // this process continues that checkpoint and may replace it
   checkpoint_seen_id_ = c.checkpoint_id;

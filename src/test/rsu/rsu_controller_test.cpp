@@ -194,12 +194,12 @@ TEST(RsuControllerOptions, RejectsBadFieldsNamingThem) {
   bad([](auto& o) { o.x_end_m = 800.0; }, "x_end_m");
   bad([](auto& o) { o.num_lanes = 0; }, "num_lanes");
   bad([](auto& o) { o.gradient_steps_per_decision = -0.5; }, "gradient_steps_per_decision");
-  bad([](auto& o) { o.collision_penalty = NaN; }, "collision_penalty");
-  bad([](auto& o) { o.collision_penalty = -1.0; }, "collision_penalty");
-  bad([](auto& o) { o.exit_taken_bonus = -1.0; }, "exit_taken_bonus");
-  bad([](auto& o) { o.exit_taken_bonus = NaN; }, "exit_taken_bonus");
-  bad([](auto& o) { o.exit_missed_penalty = -1.0; }, "exit_missed_penalty");
-  bad([](auto& o) { o.merge_failed_penalty = NaN; }, "merge_failed_penalty");
+  bad([](auto& o) { o.terminal.collision_penalty = NaN; }, "collision_penalty");
+  bad([](auto& o) { o.terminal.collision_penalty = -1.0; }, "collision_penalty");
+  bad([](auto& o) { o.terminal.exit_taken_bonus = -1.0; }, "exit_taken_bonus");
+  bad([](auto& o) { o.terminal.exit_taken_bonus = NaN; }, "exit_taken_bonus");
+  bad([](auto& o) { o.terminal.exit_missed_penalty = -1.0; }, "exit_missed_penalty");
+  bad([](auto& o) { o.terminal.merge_failed_penalty = NaN; }, "merge_failed_penalty");
   bad([](auto& o) { o.num_lanes = 4; }, "pdqn.state_size");  // 40 + 4 = 44 != 45
   bad([](auto& o) { o.reward.rho = NaN; }, "reward");
   bad([](auto& o) { o.scales.speed_mps = 0.0; }, "scales");
@@ -332,7 +332,7 @@ TEST(RsuController, HandedOverCavContinuesWithItsStateNow) {
 TEST(RsuController, CollidedCavIsTerminalWithThePenalty) {
   for (const bool teleport : {false, true}) {
     RsuControllerOptions o = smallOptions();
-    o.collision_penalty = 2.0;
+    o.terminal.collision_penalty = 2.0;
     RsuController c(o);
     const RoadSnapshot before = road({cav("a", 1, 900.0, 20.0, 1.0), cav("b", 3, 1000.0)});
     c.decide(before, 1, 0.1, GLOBAL, NONE);
@@ -371,7 +371,7 @@ TEST(RsuController, CollidedCavStillInTheSnapshotIsNotAdvised) {
 TEST(RsuController, ExitArrivalAndDisappearanceAreTerminalWithoutPenalty) {
   for (int kind = 0; kind < 3; ++kind) {
     RsuControllerOptions o = smallOptions();
-    o.collision_penalty = 5.0;  // must not apply
+    o.terminal.collision_penalty = 5.0;  // must not apply
     RsuController c(o);
     c.decide(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE);
     VehicleOutcomes events;
@@ -392,7 +392,7 @@ TEST(RsuController, ExitArrivalAndDisappearanceAreTerminalWithoutPenalty) {
 
 TEST(RsuController, VanishedCavGetsTheCollisionPenaltyOfALateEvent) {
   RsuControllerOptions o = smallOptions();
-  o.collision_penalty = 5.0;
+  o.terminal.collision_penalty = 5.0;
   RsuController c(o);
   c.decide(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE);
   c.decide(road({}), 2, 0.2, GLOBAL, NONE);  // gone; its COLLISION event comes later
@@ -407,7 +407,7 @@ TEST(RsuController, VanishedCavGetsTheCollisionPenaltyOfALateEvent) {
 TEST(RsuController, CavOnItsOffRampIsTheExitTakenWithoutWaitingForTheEvent) {
   for (double bonus : {0.0, 2.0}) {
     RsuControllerOptions o = smallOptions();
-    o.exit_taken_bonus = bonus;
+    o.terminal.exit_taken_bonus = bonus;
     RsuController c(o);
     c.decide(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE);
     VehicleSnapshot off = cav("a", 0, 930.0, 15.0);
@@ -425,8 +425,8 @@ TEST(RsuController, PassingTheExitIsPenalisedAndTerminalWhenAsked) {
   for (bool ours : {false, true}) {
     RsuControllerOptions o = smallOptions();
     if (ours) {
-      o.exit_missed_penalty = 10.0;
-      o.exit_missed_terminal = true;
+      o.terminal.exit_missed_penalty = 10.0;
+      o.terminal.exit_missed_terminal = true;
     }
     RsuController c(o);
     VehicleSnapshot before = cav("a", 3, 900.0);
@@ -442,7 +442,7 @@ TEST(RsuController, PassingTheExitIsPenalisedAndTerminalWhenAsked) {
 
 TEST(RsuController, FailedMergeIsPenalised) {
   RsuControllerOptions o = smallOptions();
-  o.merge_failed_penalty = 5.0;
+  o.terminal.merge_failed_penalty = 5.0;
   RsuController c(o);
   c.decide(road({cav("a", 1, 900.0)}), 1, 0.1, GLOBAL, NONE);
   VehicleOutcomes events;
@@ -728,6 +728,41 @@ TEST(RsuController, LoadCheckpointRefusesFilesThatAreNotOursAndStaysUntouched) {
   std::ofstream(garbage + "/controller.txt")
       << "palcas_rsu_controller 1\nrsu_id rsu_1\nbogus 1\n";
   refused(garbage, "unknown key 'bogus'");
+}
+
+// controller.txt's format is fixed: these keys in this order (checkpoints written by every
+// earlier version load), and a file from before checkpoint_id existed loads.
+TEST(RsuController, ControllerFileKeepsItsKeysAndLoadsWithoutACheckpointId) {
+  RsuController c(smallOptions());
+  for (int call = 1; call <= 3; ++call) c.decide(eightCavs(call), call, 0.1 * call, GLOBAL, NONE);
+  const std::string dir = freshDir("rsu_ckpt_format");
+  c.saveCheckpoint(dir);
+  std::ifstream in(dir + "/controller.txt");
+  std::string line, without_id;
+  std::vector<std::string> keys;
+  while (std::getline(in, line)) {
+    keys.push_back(line.substr(0, line.find(' ')));
+    if (keys.back() != "checkpoint_id") without_id += line + "\n";
+  }
+  EXPECT_EQ(keys, (std::vector<std::string>{"palcas_rsu_controller", "rsu_id", "layout_checksum",
+                                            "samples_since_federation", "gradient_credit",
+                                            "grad_steps_at_round", "model_version",
+                                            "federation_round", "transitions_stored", "decisions",
+                                            "checkpoint_id"}));
+  std::ofstream(dir + "/controller.txt") << without_id;
+  RsuController old(smallOptions());
+  old.loadCheckpoint(dir);
+  EXPECT_EQ(old.stats().decisions, 3u);
+  EXPECT_EQ(old.stats().transitions_stored, 16u);  // 8 CAVs closed at calls 2 and 3
+  EXPECT_EQ(old.samplesSinceFederation(), 16u);
+
+  RsuController other(smallOptions());
+  std::string too_big = without_id;
+  too_big.replace(too_big.find("model_version 0"), 15, "model_version 4294967296");
+  std::ofstream(dir + "/controller.txt") << too_big;
+  palcas_test::expectThrowNaming<std::runtime_error>([&] { other.loadCheckpoint(dir); },
+                                                     "beyond 32 bits");
+  EXPECT_EQ(other.stats().decisions, 0u);  // untouched
 }
 
 TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {

@@ -10,8 +10,8 @@
 #include <array>
 #include <cstdint>
 #include <limits>
-#include <map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "palcas_core/common/action.h"
@@ -19,9 +19,10 @@
 #include "palcas_core/learning/model_blob.h"
 #include "palcas_core/learning/pdqn_agent.h"
 #include "palcas_core/learning/pdqn_config.h"
-#include "palcas_core/metrics/vehicle_event.h"
 #include "palcas_core/reward/reward.h"
+#include "palcas_core/reward/terminal_rewards.h"
 #include "palcas_core/rsu/cluster_stats.h"
+#include "palcas_core/rsu/transition_book.h"
 #include "palcas_core/state/state_builder.h"
 
 namespace palcas::rsu {
@@ -40,20 +41,9 @@ struct RsuControllerOptions {
   /// Local gradient steps between federation rounds (paper E = 2500); 0 = never due
   /// (independent baseline).
   uint64_t federation_interval_steps = 2500;
-  /// Subtracted from the last reward of a CAV removed by a COLLISION or TELEPORT event
-  /// (>= 0, finite). Default 0: the paper defines no terminal penalty.
-  double collision_penalty = 0.0;
-  // Terminal outcomes (the paper defines none; src/doc/rsu.md "Terminal transitions").
-  // Each is >= 0 and finite; 0 and false are the paper's behaviour.
-  /// Added to the transition that ends on the CAV's own off-ramp (exit taken; terminal).
-  double exit_taken_bonus = 0.0;
-  /// Subtracted from the transition in which a CAV passed its off-ramp without taking it.
-  double exit_missed_penalty = 0.0;
-  /// true: that transition is terminal (the task of reaching the exit ended, failed); the
-  /// CAV's later decisions are new episodes of a through vehicle. false: it goes on.
-  bool exit_missed_terminal = false;
-  /// Subtracted from the transition in which a merging CAV failed (MERGE_FAILED event).
-  double merge_failed_penalty = 0.0;
+  /// Rewards of collisions, exits taken or missed and failed merges (the paper defines
+  /// none: all 0 / false by default; reward/terminal_rewards.h).
+  TerminalRewards terminal;
   /// true: a transition's reward is the mean of the per-step rewards over the period the
   /// decision held (every bridge step up to the next decision, fed by observeStep()).
   /// false (paper): the reward of the one snapshot at the next decision.
@@ -63,24 +53,8 @@ struct RsuControllerOptions {
   PdqnConfig pdqn;      ///< agent hyper-parameters (seed included)
 
   /// Throws std::invalid_argument naming the first bad field ("x_end_m", "pdqn.state_size",
-  /// "reward.rho", ...) and its value.
+  /// "reward: rho", "terminal: collision_penalty", ...) and its value.
   void validate() const;
-};
-
-/// Ids of vehicles that something happened to since the previous decide() call (from
-/// palcas_msgs/VehicleEvent). Ids that this RSU does not know are ignored.
-struct VehicleOutcomes {
-  std::vector<std::string> collided;     ///< COLLISION: removed; terminal with penalty
-  std::vector<std::string> teleported;   ///< TELEPORT: removed; terminal with penalty
-  std::vector<std::string> arrived;      ///< ARRIVED: left at its route's end; terminal
-  std::vector<std::string> exited;       ///< EXIT_OK: on its own off-ramp; terminal
-  std::vector<std::string> exit_missed;  ///< EXIT_MISSED: still on the road
-  std::vector<std::string> merge_failed; ///< MERGE_FAILED: penalised, not terminal
-
-  /// Files `id` under the list of `kind`; DEPARTED, MERGE_OK and MERGE_FAILED are ignored
-  /// (they end nothing). Never throws except std::bad_alloc.
-  void add(metrics::VehicleEventKind kind, const std::string& id);
-  void clear();
 };
 
 /// The advisory for one member CAV.
@@ -132,8 +106,22 @@ ActionMask possibleActions(int lane, int num_lanes);
 /// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 
-/// One RSU k: membership, batched PDQN decisions, transitions, gradient steps, federation
-/// bookkeeping and checkpoints for zone [x_start_m, x_end_m). Deterministic for a seed
+/// The controller's counters that a checkpoint carries beside the agent: one key of
+/// controller.txt each (the one list of the keys: rsu_controller_io.cpp; src/doc/rsu.md,
+/// "Checkpoints").
+struct ControllerCounters {
+  uint64_t samples_since_federation = 0;  ///< n_k
+  double gradient_credit = 0.0;           ///< gradient steps earned but not made, in [0, 1)
+  uint64_t grad_steps_at_round = 0;       ///< the agent's gradient steps at the last global model
+  uint32_t model_version = 0;
+  uint32_t federation_round = 0;          ///< global models loaded so far
+  uint64_t transitions_stored = 0;
+  uint64_t decisions = 0;                 ///< decide() / advise() calls
+};
+
+/// One RSU k: membership, batched PDQN decisions, transitions (stored as its TransitionBook
+/// closes them), gradient steps, federation bookkeeping and checkpoints for zone
+/// [x_start_m, x_end_m). Deterministic for a seed
 /// (one Eigen thread). Not thread-safe: call from one thread. Movable, not copyable.
 class RsuController {
  public:
@@ -179,7 +167,7 @@ class RsuController {
   /// The local model to submit (online networks).
   ModelBlob exportModel() const { return agent_.exportModel(); }
   /// n_k: transitions stored since the last loadGlobalModel() (or construction).
-  uint64_t samplesSinceFederation() const { return samples_since_federation_; }
+  uint64_t samplesSinceFederation() const { return counters_.samples_since_federation; }
   /// Imports the global model and starts a new round: clears the due flag and n_k,
   /// sets the model version, counts the round. Throws std::invalid_argument (local model
   /// and counters kept) on another layout, a bad checksum, wrong size, non-finite value,
@@ -206,52 +194,35 @@ class RsuController {
   RsuControllerStats stats() const;
   const RsuControllerOptions& options() const { return options_; }
   const PdqnAgent& agent() const { return agent_; }
-  uint32_t modelVersion() const { return model_version_; }
-  uint32_t federationRound() const { return federation_round_; }
+  uint32_t modelVersion() const { return counters_.model_version; }
+  uint32_t federationRound() const { return counters_.federation_round; }
   /// Members whose last decision waits for its outcome (train mode).
-  size_t pendingCount() const { return pending_.size(); }
+  size_t pendingCount() const { return book_.pendingCount(); }
 
  private:
-  /// A member's last decision, waiting for its outcome.
-  struct Pending {
-    nn::Vector state;
-    ActionMask valid_actions = ALL_ACTIONS;  ///< in `state`: s' of a transition ending there
-    Decision decision;
-    double reward = 0.0;  ///< reward at that observation (for terminal transitions)
-    double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
-    double period_reward_sum = 0.0;   ///< rewards of the steps since (reward_over_period)
-    int period_steps = 0;
-    /// The reward the transition gets: the period mean including `now` when kept.
-    double periodReward(double now, bool over_period) const {
-      return over_period ? (period_reward_sum + now) / (period_steps + 1) : now;
-    }
-    /// Mean reward since the decision, or the decision's own when no step was seen.
-    double lastReward() const {
-      return period_steps > 0 ? period_reward_sum / period_steps : reward;
-    }
-  };
   struct Observation;  // everything decide() computes before changing any state
 
   Observation observe(const RoadSnapshot& snapshot, const GlobalDensities& global,
                       const VehicleOutcomes& outcomes) const;
-  void closePending(const Observation& obs);
+  std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
+                                                      const MemberColumns& columns,
+                                                      const PendingFates& fates,
+                                                      const RoadIndex& road,
+                                                      const NeighbourFinder& finder,
+                                                      const ClusterStats& stats,
+                                                      const GlobalDensities& global) const;
+  /// Remembers the closed transitions (id order) and counts them for the stats and n_k.
+  void storeClosures(const std::vector<Closure>& closures);
   void runGradientSteps();
 
   RsuControllerOptions options_;
   StateBuilder builder_;
   PdqnAgent agent_;
-  std::map<std::string, Pending> pending_;  // ordered: transitions are stored by id
-  // Vanished without an event: its COLLISION / ARRIVED event may still be on its way
-  // (another topic), so the transition is closed one decision later.
-  std::map<std::string, Pending> limbo_;
+  TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
-  double gradient_credit_ = 0.0;
-  uint64_t samples_since_federation_ = 0;
-  uint64_t grad_steps_at_round_ = 0;
-  uint32_t model_version_ = 0;
-  uint32_t federation_round_ = 0;
-  RsuControllerStats stats_;
+  ControllerCounters counters_;  // what a checkpoint carries besides the agent
+  RsuControllerStats stats_;      // of the last decision (counters_ and the agent's aside)
   // The checkpoint this controller continues (loaded or last wrote): saveCheckpoint only
   // replaces a file with this id (mutable: saving does not change what the controller does).
   mutable bool checkpoint_owned_ = false;
