@@ -2,7 +2,7 @@
 
 #include <palcas_common/param_reader.h>
 #include <palcas_common/v2x_params.h>
-#include <palcas_sim/sumo_outputs.h>
+#include "palcas_sim/sumo_outputs.h"
 
 #include <cmath>
 #include <map>

@@ -2,7 +2,7 @@
 
 #include <nlohmann/json.hpp>
 #include <palcas_core/common/atomic_file.h>
-#include <palcas_sim/sumo_outputs.h>
+#include "palcas_sim/sumo_outputs.h"
 
 #include <algorithm>
 #include <cmath>
