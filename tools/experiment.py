@@ -32,9 +32,8 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 import experiment_results  # noqa: E402
+from palcas_arms import ALL_ARMS, LEARNING_ARMS  # noqa: E402
 
-LEARNING_ARMS = ("palcas", "palcas_assist", "centralized", "independent", "no_priority")
-ALL_ARMS = LEARNING_ARMS + ("keep", "sumo_native")
 PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.

@@ -38,6 +38,9 @@ import socket
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import palcas_arms  # noqa: E402
+
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
             "scenario": "paper", "explore_fraction": 0.5, "demand": None, "ramp_demand": None,
@@ -283,10 +286,6 @@ def scenario_clusters(root, scenario):
     return int(m.group(1))
 
 
-def rsu_ids(arm, clusters):
-    return ["central"] if arm == "centralized" else ["rsu_%d" % k for k in range(clusters)]
-
-
 def git_commit(root):
     try:
         return subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True,
@@ -378,7 +377,7 @@ def run_launches(root, out, opts, record, args, interrupt):
                 + launch_args, stdout=console, stderr=subprocess.STDOUT, env=env)
             monitor = subprocess.Popen(
                 ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(root, "tools", "train_monitor.py"),
-                 "--rsus"] + rsu_ids(opts["arm"], clusters)
+                 "--rsus"] + palcas_arms.rsu_ids(opts["arm"], clusters)
                 + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
                    "--duration", number_text(opts["duration"]), "--period", "15"],
                 stderr=subprocess.DEVNULL, env=env)
@@ -457,6 +456,8 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     given = {k: getattr(args, k) for k in ALL_GIVEN}
     try:
+        if given["arm"] is not None and not palcas_arms.is_learning(given["arm"]):
+            raise OptionError("--arm '%s': not a learning arm (%s)" % (given["arm"], ", ".join(palcas_arms.LEARNING_ARMS)))
         for option, low, high in (("demand_range", 0, MAX_DEMAND), ("pr_range", 0, 100)):
             if given[option] is not None:
                 given[option] = parse_range(given[option], "--" + option.replace("_", "-"), low, high)
