@@ -29,6 +29,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import policy_folder  # noqa: E402
 from palcas_arms import sort_arms  # noqa: E402
 
 COMFORT_MPS2 = 1.47  # a_th, paper "Driving Comfort"
@@ -223,7 +224,7 @@ def learning_curves(policies, prefix):
     """Per-episode training metrics of every learning arm, one page."""
     data = {}
     for arm, d in policies.items():
-        f = pathlib.Path(d) / "episodes.csv"
+        f = pathlib.Path(d) / policy_folder.EPISODES
         if f.exists():
             with open(f, newline="") as fh:
                 data[arm] = list(csv.DictReader(fh))

@@ -40,6 +40,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import palcas_arms  # noqa: E402
+import policy_folder  # noqa: E402
 
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
@@ -125,7 +126,7 @@ def sampled(opts):
 
 
 def read_record(out):
-    path = os.path.join(out, "train.json")
+    path = str(policy_folder.train_record_path(out))
     try:
         with open(path) as f:
             record = json.load(f)
@@ -143,7 +144,7 @@ def settle_options(given, out, resume):
     a given option that contradicts it (--episodes may grow). Raises OptionError."""
     opts = dict(DEFAULTS)
     opts.update({k: v for k, v in given.items() if v is not None})
-    record_path = os.path.join(out, "train.json") if out else ""
+    record_path = str(policy_folder.train_record_path(out)) if out else ""
     if not resume:
         if record_path and os.path.isfile(record_path):
             raise OptionError("--out '%s' already holds a training: use --resume, or another --out" % out)
@@ -200,7 +201,7 @@ def write_record(out, opts, git_commit):
     with open(tmp, "w") as f:
         json.dump(record, f)
         f.write("\n")
-    os.replace(tmp, os.path.join(out, "train.json"))
+    os.replace(tmp, str(policy_folder.train_record_path(out)))
     return record
 
 
@@ -362,7 +363,7 @@ def run_launches(root, out, opts, record, args, interrupt):
             "ramp_demand:=%s" % ("scenario" if opts.get("ramp_demand") is None else number_text(opts["ramp_demand"])),
             "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % count,
             "first_episode:=%d" % nxt, "duration:=%s" % number_text(opts["duration"]),
-            "checkpoint_dir:=%s" % os.path.join(out, "checkpoints"), "resume:=%s" % resume_nodes,
+            "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=%s" % resume_nodes,
             "out_dir:=%s" % out, "learning_params:=%s" % (opts.get("learning") or "none"),
             "rsu_params:=%s" % (opts.get("rsu_params") or "none"),
             "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
@@ -477,7 +478,7 @@ def main(argv=None):
                     paper_printed=args.paper_printed)
     out = args.out or os.path.join(args.results_dir or os.path.join(args.root, "results"), "train-%s-%s" % (
         opts["arm"], datetime.datetime.now().strftime("%Y%m%d-%H%M%S")))
-    os.makedirs(os.path.join(out, "checkpoints"), exist_ok=True)
+    os.makedirs(policy_folder.checkpoints(out), exist_ok=True)
     out = os.path.abspath(out)
     if args.resume and episodes_done(out) >= int(opts["episodes"]):
         log("all %d episodes done in %s" % (int(opts["episodes"]), out))
