@@ -67,7 +67,11 @@ def load(path=REGISTRY):
     text = pathlib.Path(path).read_text()
     arms = json.loads(text)
     # What system.launch reads: the text as a Python literal with true/false defined.
-    if eval(text, {"__builtins__": {}}, {"true": True, "false": False}) != arms:  # noqa: S307
+    try:
+        as_launch_reads = eval(text, {"__builtins__": {}}, {"true": True, "false": False})  # noqa: S307
+    except (NameError, SyntaxError) as e:
+        raise RegistryError(f"{path}: roslaunch cannot read it as a Python literal ({e})")
+    if as_launch_reads != arms:
         raise RegistryError(f"{path}: read as a Python literal it differs from its JSON (roslaunch reads it so)")
     return check(arms)
 
