@@ -8,11 +8,14 @@ import json
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import policy_folder  # noqa: E402
+
 
 def main(metrics_path, train_dir):
     metrics_path = pathlib.Path(metrics_path)
     metrics = json.loads(metrics_path.read_text())
-    state = pathlib.Path(train_dir) / "checkpoints" / "fedserver" / "federation_state.json"
+    state = policy_folder.federation_state(train_dir)
     rounds = 0
     if state.exists():
         rounds = json.loads(state.read_text()).get("rounds_closed", 0)

@@ -32,9 +32,9 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
 import experiment_results  # noqa: E402
+import policy_folder  # noqa: E402
+from palcas_arms import ALL_ARMS, LEARNING_ARMS  # noqa: E402
 
-LEARNING_ARMS = ("palcas", "palcas_assist", "centralized", "independent", "no_priority")
-ALL_ARMS = LEARNING_ARMS + ("keep", "sumo_native")
 PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.
@@ -68,10 +68,9 @@ def point_name(arm, pr, seed, demand=None):
 
 def training_seeds(policy_dir):
     """Seeds a policy trained on (train.json: seed, seed+1, ... one per episode)."""
-    f = pathlib.Path(policy_dir) / "train.json"
-    if not f.exists():
+    if not policy_folder.train_record_path(policy_dir).exists():
         return set()
-    t = json.loads(f.read_text())
+    t = policy_folder.train_record(policy_dir)
     return set(range(int(t["seed"]), int(t["seed"]) + int(t["episodes"])))
 
 
@@ -113,12 +112,11 @@ def settings_from_args(a):
     for arm in arms:
         if arm not in LEARNING_ARMS:
             continue
-        policy = policies.get(arm, str(ROOT / "policies" / arm))
-        if not (pathlib.Path(policy) / "checkpoints").is_dir() or \
-                not (pathlib.Path(policy) / "train.json").exists():
+        policy = policies.get(arm, str(policy_folder.shipped(arm)))
+        if policy_folder.why_not(policy):
             raise UsageError(f"arm '{arm}': no trained policy at {policy} (train it with "
                              f"./palcas train --arm {arm}, or pass --policy {arm}=DIR)")
-        learnt_on = json.loads((pathlib.Path(policy) / "train.json").read_text())["scenario"]
+        learnt_on = policy_folder.train_record(policy)["scenario"]
         if state_size(learnt_on) != state_size(a.scenario):
             raise UsageError(f"arm '{arm}': the policy {policy} was trained on road {learnt_on} "
                              f"(state size {state_size(learnt_on)}), road {a.scenario} has "

@@ -13,6 +13,7 @@ import pathlib
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from palcas_arms import title  # noqa: E402
 from palcas_stats import format_ci, mean_ci95  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -36,9 +37,6 @@ EXTRA = ["efficiency_cav_mps", "insertion_dropped", "mean_travel_time_s", "lane_
          "decision_ms_p99", "lane_changes_dropped", "collisions",
          "teleports", "cavs_seen", "exiting_cavs", "merging_cavs", "sim_seconds",
          "wall_seconds", "real_time_factor"]
-ARM_TITLES = {"palcas": "PALCAS", "palcas_assist": "PALCAS (assist mode)", "centralized": "Baseline-1 (centralized)",
-              "independent": "Baseline-2 (independent)", "no_priority": "no priority (ablation)",
-              "keep": "keep", "sumo_native": "SUMO-native"}
 
 
 def read_paper(path=PAPER_RESULTS):
@@ -194,9 +192,9 @@ def write_tables(out, settings, rows, agg, paper):
                 md.append(f"\n### {demand_title(demand)}\n")
             head = ["PR (%)"]
             for arm in arms:
-                head.append(ARM_TITLES.get(arm, arm))
+                head.append(title(arm))
                 if arm in has_paper:
-                    head.append(f"{ARM_TITLES.get(arm, arm)}, paper")
+                    head.append(f"{title(arm)}, paper")
             md.append("| " + " | ".join(head) + " |")
             md.append("|" + "---|" * len(head))
             for pr in prs:
@@ -271,7 +269,7 @@ def draw_capacity(out, arms, prs, rows):
                     table.append([arm, f"{pr:g}", f"{demand:g}", key, len(vals), round(mean, 4),
                                   round(half, 4) if math.isfinite(half) else ""])
                 if xs:
-                    ax.errorbar(xs, ys, yerr=hs, marker="o", capsize=3, label=ARM_TITLES.get(arm, arm))
+                    ax.errorbar(xs, ys, yerr=hs, marker="o", capsize=3, label=title(arm))
             ax.set_xlabel("mainline demand (veh/h per lane)")
             ax.set_ylabel(label)
             ax.set_title(f"PR {pr:g} %")

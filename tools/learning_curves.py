@@ -10,6 +10,9 @@ import math
 import pathlib
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import policy_folder  # noqa: E402
+
 import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -30,8 +33,8 @@ def number(row, key):
 
 def main(run_dir):
     run = pathlib.Path(run_dir)
-    episodes = read(run / "episodes.csv")
-    rsu_logs = {p.parent.name: read(p) for p in sorted((run / "checkpoints").glob("*/learning.csv"))}
+    episodes = read(run / policy_folder.EPISODES)
+    rsu_logs = {p.parent.name: read(p) for p in policy_folder.learning_logs(run)}
     merged = []
     for i, ep in enumerate(episodes):
         row = {k: ep[k] for k in ("episode", "efficiency_all_mps", "collision_rate_pct", "dsr_pct",

@@ -28,16 +28,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import policy_folder  # noqa: E402
+from palcas_arms import sort_arms  # noqa: E402
+
 COMFORT_MPS2 = 1.47  # a_th, paper "Driving Comfort"
 ROUTES = ("main_through", "main_exit", "ramp_through", "ramp_exit")
 ROUTE_TITLES = {"main_through": "mainline -> mainline", "main_exit": "mainline -> off-ramp",
                 "ramp_through": "on-ramp -> mainline", "ramp_exit": "on-ramp -> off-ramp"}
 ON_MAINLINE = ("mainline", "accel_lane")
-ARM_ORDER = ("palcas", "palcas_assist", "centralized", "independent", "no_priority", "keep", "sumo_native")
-
-
-def arm_sort(arms):
-    return sorted(arms, key=lambda a: (ARM_ORDER.index(a) if a in ARM_ORDER else len(ARM_ORDER), a))
 
 
 def read_trajectories(path):
@@ -79,7 +78,7 @@ def speed_over_time(trajs, prefix, bin_s=30.0):
         counts = np.bincount(b)
         series[arm] = {int(i): sums[i] / counts[i] for i in range(len(counts)) if counts[i] > 0}
     bins = sorted({i for s in series.values() for i in s})
-    arms = arm_sort(series)
+    arms = sort_arms(series)
     write_csv(f"{prefix}.csv", ["time_s"] + [f"{a}_mps" for a in arms],
               [[(i + 0.5) * bin_s] + [round(series[a].get(i, float("nan")), 3) for a in arms] for i in bins])
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -151,7 +150,7 @@ def vehicle_track(t, vid):
 
 def accel_and_lanes(trajs, prefix_accel, prefix_lanes):
     picks = pick_vehicles(trajs)
-    arms = arm_sort(trajs)
+    arms = sort_arms(trajs)
     rows = []
     fig_a, axes_a = plt.subplots(2, 2, figsize=(10, 6.5), squeeze=False)
     fig_l, axes_l = plt.subplots(2, 2, figsize=(10, 6.5), squeeze=False)
@@ -225,7 +224,7 @@ def learning_curves(policies, prefix):
     """Per-episode training metrics of every learning arm, one page."""
     data = {}
     for arm, d in policies.items():
-        f = pathlib.Path(d) / "episodes.csv"
+        f = pathlib.Path(d) / policy_folder.EPISODES
         if f.exists():
             with open(f, newline="") as fh:
                 data[arm] = list(csv.DictReader(fh))
@@ -235,14 +234,14 @@ def learning_curves(policies, prefix):
     rows = []
     for k, (key, label) in enumerate(CURVES):
         ax = axes[k // 2][k % 2]
-        for arm in arm_sort(data):
+        for arm in sort_arms(data):
             eps = [int(r["episode"]) for r in data[arm]]
             ax.plot(eps, [float(r[key]) for r in data[arm]], marker=".", label=arm)
         ax.set_xlabel("training episode")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=8)
-    for arm in arm_sort(data):
+    for arm in sort_arms(data):
         rows += [[arm, r["episode"], r["seed"]] + [r[k] for k, _ in CURVES] for r in data[arm]]
     write_csv(f"{prefix}.csv", ["arm", "episode", "seed"] + [k for k, _ in CURVES], rows)
     save(fig, prefix)

@@ -25,6 +25,9 @@ import pathlib
 import shutil
 import sys
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import policy_folder as pf  # noqa: E402
+
 
 def bridge_line(trained_with, runs_with, as_trained):
     """TRAINING.md's line on the bridge parameters the policy runs under."""
@@ -55,7 +58,7 @@ def traffic_text(train):
 def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None, default_from=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
-    train = json.loads((src / "train.json").read_text())
+    train = pf.train_record(src)
     bridge = train.get("bridge_params", "")
     if bridge_as_trained and not bridge:
         sys.exit(f"--bridge-as-trained: {src} was trained under config/bridge.yaml alone "
@@ -64,33 +67,34 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         sys.exit(f"--bridge-as-trained: the training's bridge parameters {bridge} are gone")
     if run_bridge and not pathlib.Path(run_bridge).is_file():
         sys.exit(f"--run-with-bridge: no such file {run_bridge}")
-    if default_from and not (src / "checkpoints" / default_from / "model.palcas").is_file():
+    if default_from and not pf.rsu_model(src, default_from).is_file():
         sys.exit(f"--default-from: {src} holds no checkpoints/{default_from}/model.palcas")
     run_bridge = run_bridge or (bridge if bridge_as_trained else None)
     if dst.exists():
         shutil.rmtree(dst)
-    (dst / "checkpoints").mkdir(parents=True)
-    global_model = src / "checkpoints/fedserver/global_model.palcas"
-    state = src / "checkpoints/fedserver/federation_state.json"
+    pf.checkpoints(dst).mkdir(parents=True)
+    global_model = pf.global_model(src)
+    state = pf.federation_state(src)
     if state.exists():  # the rounds the training closed (reported beside evaluations)
-        (dst / "checkpoints/fedserver").mkdir()
-        shutil.copy2(state, dst / "checkpoints/fedserver/")
+        pf.federation_state(dst).parent.mkdir()
+        shutil.copy2(state, pf.federation_state(dst))
     if global_model.exists() and not rsu_models:  # federated arms: the server's global model
-        shutil.copy2(global_model, dst / "checkpoints/fedserver/")
+        pf.global_model(dst).parent.mkdir(exist_ok=True)
+        shutil.copy2(global_model, pf.global_model(dst))
     else:  # independent / centralized, or --rsu-models: one model per RSU
-        for model in sorted(src.glob("checkpoints/*/model.palcas")):
-            (dst / "checkpoints" / model.parent.name).mkdir()
-            shutil.copy2(model, dst / "checkpoints" / model.parent.name)
+        for model in pf.rsu_models(src):
+            pf.rsu_model(dst, model.parent.name).parent.mkdir()
+            shutil.copy2(model, pf.rsu_model(dst, model.parent.name))
         default = global_model if global_model.exists() else (
-            src / "checkpoints" / default_from / "model.palcas" if default_from else None)
+            pf.rsu_model(src, default_from) if default_from else None)
         if default:  # for RSUs without a model of their own (palcas_rsu: the load order)
-            (dst / "checkpoints/default").mkdir(exist_ok=True)
-            shutil.copy2(default, dst / "checkpoints/default/model.palcas")
+            pf.rsu_model(dst, pf.DEFAULT_RSU).parent.mkdir(exist_ok=True)
+            shutil.copy2(default, pf.rsu_model(dst, pf.DEFAULT_RSU))
             train["default_model"] = "global" if default == global_model else default_from
-    for csv_file in sorted(src.glob("checkpoints/*/learning.csv")):
-        (dst / "checkpoints" / csv_file.parent.name).mkdir(exist_ok=True)
-        shutil.copy2(csv_file, dst / "checkpoints" / csv_file.parent.name)
-    for f in ("episodes.csv", "learning_curves.csv", "learning_curves.png", "aborted_episodes.txt"):
+    for csv_file in pf.learning_logs(src):
+        (pf.checkpoints(dst) / csv_file.parent.name).mkdir(exist_ok=True)
+        shutil.copy2(csv_file, pf.checkpoints(dst) / csv_file.parent.name)
+    for f in pf.RECORD_FILES:
         if (src / f).exists():
             shutil.copy2(src / f, dst / f)
     learning = train.get("learning", "")
@@ -98,13 +102,13 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name
     if run_bridge:
-        shutil.copy2(run_bridge, dst / "bridge.yaml")
-        train["runs_with_bridge"] = "bridge.yaml"
+        shutil.copy2(run_bridge, pf.bridge_params(dst))
+        train["runs_with_bridge"] = pf.BRIDGE_PARAMS
     train["shipped_from"] = src.name
     train["shipped_models"] = "rsu" if rsu_models or not global_model.exists() else "global"
-    (dst / "train.json").write_text(json.dumps(train) + "\n")
+    pf.train_record_path(dst).write_text(json.dumps(train) + "\n")
 
-    rows = list(csv.DictReader(open(src / "episodes.csv")))
+    rows = list(csv.DictReader(open(src / pf.EPISODES)))
     sim_s = sum(float(r["sim_seconds"]) for r in rows)
     wall_s = sum(float(r["wall_seconds"]) for r in rows)
     seeds = [int(r["seed"]) for r in rows]
@@ -135,7 +139,7 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
     ]
-    (dst / "TRAINING.md").write_text("\n".join(lines) + "\n")
+    (dst / pf.TRAINING_NOTES).write_text("\n".join(lines) + "\n")
     print(f"shipped {src} -> {dst}")
 
 

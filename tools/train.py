@@ -38,6 +38,10 @@ import socket
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import palcas_arms  # noqa: E402
+import policy_folder  # noqa: E402
+
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
             "scenario": "paper", "explore_fraction": 0.5, "demand": None, "ramp_demand": None,
@@ -122,7 +126,7 @@ def sampled(opts):
 
 
 def read_record(out):
-    path = os.path.join(out, "train.json")
+    path = str(policy_folder.train_record_path(out))
     try:
         with open(path) as f:
             record = json.load(f)
@@ -140,7 +144,7 @@ def settle_options(given, out, resume):
     a given option that contradicts it (--episodes may grow). Raises OptionError."""
     opts = dict(DEFAULTS)
     opts.update({k: v for k, v in given.items() if v is not None})
-    record_path = os.path.join(out, "train.json") if out else ""
+    record_path = str(policy_folder.train_record_path(out)) if out else ""
     if not resume:
         if record_path and os.path.isfile(record_path):
             raise OptionError("--out '%s' already holds a training: use --resume, or another --out" % out)
@@ -197,7 +201,7 @@ def write_record(out, opts, git_commit):
     with open(tmp, "w") as f:
         json.dump(record, f)
         f.write("\n")
-    os.replace(tmp, os.path.join(out, "train.json"))
+    os.replace(tmp, str(policy_folder.train_record_path(out)))
     return record
 
 
@@ -283,10 +287,6 @@ def scenario_clusters(root, scenario):
     return int(m.group(1))
 
 
-def rsu_ids(arm, clusters):
-    return ["central"] if arm == "centralized" else ["rsu_%d" % k for k in range(clusters)]
-
-
 def git_commit(root):
     try:
         return subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True,
@@ -363,7 +363,7 @@ def run_launches(root, out, opts, record, args, interrupt):
             "ramp_demand:=%s" % ("scenario" if opts.get("ramp_demand") is None else number_text(opts["ramp_demand"])),
             "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % count,
             "first_episode:=%d" % nxt, "duration:=%s" % number_text(opts["duration"]),
-            "checkpoint_dir:=%s" % os.path.join(out, "checkpoints"), "resume:=%s" % resume_nodes,
+            "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=%s" % resume_nodes,
             "out_dir:=%s" % out, "learning_params:=%s" % (opts.get("learning") or "none"),
             "rsu_params:=%s" % (opts.get("rsu_params") or "none"),
             "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
@@ -378,7 +378,7 @@ def run_launches(root, out, opts, record, args, interrupt):
                 + launch_args, stdout=console, stderr=subprocess.STDOUT, env=env)
             monitor = subprocess.Popen(
                 ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(root, "tools", "train_monitor.py"),
-                 "--rsus"] + rsu_ids(opts["arm"], clusters)
+                 "--rsus"] + palcas_arms.rsu_ids(opts["arm"], clusters)
                 + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
                    "--duration", number_text(opts["duration"]), "--period", "15"],
                 stderr=subprocess.DEVNULL, env=env)
@@ -457,6 +457,8 @@ def main(argv=None):
     args = parse(sys.argv[1:] if argv is None else argv)
     given = {k: getattr(args, k) for k in ALL_GIVEN}
     try:
+        if given["arm"] is not None and not palcas_arms.is_learning(given["arm"]):
+            raise OptionError("--arm '%s': not a learning arm (%s)" % (given["arm"], ", ".join(palcas_arms.LEARNING_ARMS)))
         for option, low, high in (("demand_range", 0, MAX_DEMAND), ("pr_range", 0, 100)):
             if given[option] is not None:
                 given[option] = parse_range(given[option], "--" + option.replace("_", "-"), low, high)
@@ -476,7 +478,7 @@ def main(argv=None):
                     paper_printed=args.paper_printed)
     out = args.out or os.path.join(args.results_dir or os.path.join(args.root, "results"), "train-%s-%s" % (
         opts["arm"], datetime.datetime.now().strftime("%Y%m%d-%H%M%S")))
-    os.makedirs(os.path.join(out, "checkpoints"), exist_ok=True)
+    os.makedirs(policy_folder.checkpoints(out), exist_ok=True)
     out = os.path.abspath(out)
     if args.resume and episodes_done(out) >= int(opts["episodes"]):
         log("all %d episodes done in %s" % (int(opts["episodes"]), out))

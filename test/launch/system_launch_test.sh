@@ -79,11 +79,11 @@ names+=(demand_reaches_the_bridge); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   demand_reaches_the_bridge"; else echo "FAIL demand_reaches_the_bridge: $why"; fi
 
 # No arguments evaluates the shipped policy, under its own bridge.yaml; so does every learning
-# arm that ships one (the launch file's list of them agrees with policies/). An
-# evaluation with no weights is refused; training starts from random weights.
+# arm of the registry that ships one (tools/arm_registry_test.py checks its shipped_policy
+# against policies/). An evaluation with no weights is refused; training starts from random weights.
 why=""
-for arm in palcas palcas_assist centralized independent no_priority; do
-  rsu=rsu_0; [ "$arm" != centralized ] || rsu=central
+for arm in $(/usr/bin/python3 "$ROOT/tools/palcas_arms.py" --list learning); do
+  rsu="$(/usr/bin/python3 -c 'import sys; sys.path.insert(0, sys.argv[1]); import palcas_arms; print(palcas_arms.rsu_ids(sys.argv[2], 1)[0])' "$ROOT/tools" "$arm")"
   params="$(roslaunch --dump-params palcas_launch system.launch arm:="$arm" out_dir:=/tmp/unused 2>&1)"
   grep -q "^/$rsu/rsu/policy_dir: $ROOT/policies/$arm/checkpoints\$" <<<"$params" ||
     why="$why $arm does not evaluate policies/$arm/checkpoints;"

@@ -294,8 +294,6 @@ class ConsoleLog(unittest.TestCase):
     def test_clusters_come_from_the_roads_description(self):
         self.assertEqual(train.scenario_clusters(str(ROOT), "paper"), 3)
         self.assertEqual(train.scenario_clusters(str(ROOT), "tiny"), 2)
-        self.assertEqual(train.rsu_ids("centralized", 3), ["central"])
-        self.assertEqual(train.rsu_ids("palcas", 2), ["rsu_0", "rsu_1"])
 
 
 class ScenarioFiles(unittest.TestCase):

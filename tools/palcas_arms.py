@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""The arm registry: config/arms.json, one entry per arm, read by ./palcas, the tools and
+launch/system.launch alike. Adding an arm is adding its entry there.
+
+An entry's fields:
+  what              one line for help texts
+  title             its name in tables and figures (config/paper_results.csv rows use the arm's key)
+  rsus              zones (one RSU per zone: rsu_0, rsu_1, ...) | central (one RSU, central,
+                    over the whole road) | none (no RSU: nothing learns)
+  federation, i2i   the RSUs federate through the server / talk to their neighbours
+  priority_reward   the reward's priority terms (false: lambda = 0)
+  advisory_control  the bridge carries out advice (false: SUMO's own models for every vehicle)
+  assist_mode       the bridge's assist_mode (advice on top of the CAVs' own lane changing)
+  shipped_policy    policies/<arm>/ is this arm's shipped policy, bridge.yaml included (the
+                    launch loads that bridge.yaml when it evaluates the shipped policy)
+
+JSON because roslaunch's $(eval) reads the same file as a Python literal (it has no YAML
+parser); load() checks both readings agree.
+
+usage: palcas_arms.py --list all|learning   the arm names, one a line
+       palcas_arms.py --bash                 shell assignments ARMS, LEARNING_ARMS for ./palcas
+       palcas_arms.py --help-text            an "arms:" section for ./palcas help"""
+import json
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+REGISTRY = ROOT / "config" / "arms.json"
+FIELDS = {"what": str, "title": str, "rsus": str, "federation": bool, "i2i": bool,
+          "priority_reward": bool, "advisory_control": bool, "assist_mode": bool,
+          "shipped_policy": bool}
+RSU_RULES = ("zones", "central", "none")
+# An arm's name becomes a launch argument, a folder name and part of experiment point names.
+NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+class RegistryError(Exception):
+    pass
+
+
+def check(arms):
+    """Refuses an entry that misses a field, has one of the wrong type, or contradicts itself."""
+    if not isinstance(arms, dict) or not arms:
+        raise RegistryError("the registry is not a mapping of arm names to entries")
+    for name, entry in arms.items():
+        if not NAME.match(name):
+            raise RegistryError(f"arm '{name}': a name is lower-case letters, digits and _")
+        if not isinstance(entry, dict) or set(entry) != set(FIELDS):
+            raise RegistryError(f"arm '{name}': fields {sorted(entry) if isinstance(entry, dict) else entry}, "
+                                f"expected {sorted(FIELDS)}")
+        for field, kind in FIELDS.items():
+            if type(entry[field]) is not kind:
+                raise RegistryError(f"arm '{name}': {field} is not a {kind.__name__}")
+        if entry["rsus"] not in RSU_RULES:
+            raise RegistryError(f"arm '{name}': rsus '{entry['rsus']}' is not one of {', '.join(RSU_RULES)}")
+        if entry["rsus"] != "zones" and (entry["federation"] or entry["i2i"]):
+            raise RegistryError(f"arm '{name}': federation and i2i need RSUs per zone")
+        if entry["rsus"] == "none" and (entry["priority_reward"] or entry["shipped_policy"]):
+            raise RegistryError(f"arm '{name}': without RSUs there is no reward and no policy")
+        if entry["assist_mode"] and not entry["advisory_control"]:
+            raise RegistryError(f"arm '{name}': assist_mode needs advisory_control")
+    return arms
+
+
+def load(path=REGISTRY):
+    text = pathlib.Path(path).read_text()
+    arms = json.loads(text)
+    # What system.launch reads: the text as a Python literal with true/false defined.
+    try:
+        as_launch_reads = eval(text, {"__builtins__": {}}, {"true": True, "false": False})  # noqa: S307
+    except (NameError, SyntaxError) as e:
+        raise RegistryError(f"{path}: roslaunch cannot read it as a Python literal ({e})")
+    if as_launch_reads != arms:
+        raise RegistryError(f"{path}: read as a Python literal it differs from its JSON (roslaunch reads it so)")
+    return check(arms)
+
+
+ARMS = load()
+ALL_ARMS = tuple(ARMS)
+LEARNING_ARMS = tuple(a for a in ARMS if ARMS[a]["rsus"] != "none")
+
+
+def is_learning(arm):
+    return arm in LEARNING_ARMS
+
+
+def title(arm):
+    """The arm's name in tables and figures (an unknown one: itself)."""
+    return ARMS[arm]["title"] if arm in ARMS else arm
+
+
+def rsu_ids(arm, clusters):
+    """The RSUs an arm runs on a road with this many zones."""
+    rule = ARMS[arm]["rsus"]
+    return ["central"] if rule == "central" else ["rsu_%d" % k for k in range(clusters)] if rule == "zones" else []
+
+
+def sort_arms(arms):
+    """Registry order; arms it does not know last, by name."""
+    return sorted(arms, key=lambda a: (ALL_ARMS.index(a) if a in ARMS else len(ALL_ARMS), a))
+
+
+def help_text():
+    width = max(len(a) for a in ALL_ARMS)
+    lines = ["arms (config/arms.json; a learning arm's shipped policy is policies/<arm>/):"]
+    for a in ALL_ARMS:
+        kind = "learning" if is_learning(a) else "no RSU  "
+        lines.append(f"  {a:<{width}}  {kind}  {ARMS[a]['what']}")
+    return "\n".join(lines)
+
+
+def main(argv):
+    if argv == ["--list", "all"]:
+        print("\n".join(ALL_ARMS))
+    elif argv == ["--list", "learning"]:
+        print("\n".join(LEARNING_ARMS))
+    elif argv == ["--bash"]:
+        print(f"ARMS='{' '.join(ALL_ARMS)}'")
+        print(f"LEARNING_ARMS='{' '.join(LEARNING_ARMS)}'")
+    elif argv == ["--help-text"]:
+        print(help_text())
+    else:
+        sys.exit(__doc__.split("\n\n")[-1])
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
