@@ -345,7 +345,9 @@ def collect(out, settings, points):
 def merge(out, csv_paths, seeds, duration_s, scenario):
     """Tables from the results.csv of several experiments on the same road, seeds and
     duration (e.g. arms run in different sessions): rows are taken as they are, a point
-    present twice is an error. Figures stay with each experiment (they need its runs)."""
+    present twice is an error. Figures stay with each experiment (they need its runs), except
+    the capacity figure, drawn from the rows when they hold more than one demand: it puts
+    arms evaluated apart side by side."""
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     rows, seen, arms, prs = [], set(), [], []
@@ -370,6 +372,8 @@ def merge(out, csv_paths, seeds, duration_s, scenario):
     rows = mark_jams(rows)
     write_results_csv(out, rows)
     write_tables(out, settings, rows, aggregate(rows, arms, settings["prs"], demands_of(rows)), read_paper())
+    if len([d for d in demands_of(rows) if d is not None]) > 1:
+        draw_capacity(out, arms, settings["prs"], rows)
     return rows
 
 

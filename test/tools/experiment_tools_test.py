@@ -287,6 +287,22 @@ class DemandCollectorTest(unittest.TestCase):
         self.assertAlmostEqual(float(keep["mean"]), 3 * 1000 * (24.0 + 26.0 + 13.0) / 3 / 25.0, places=3)
         self.assertGreater(float(keep["ci95_half"]), 0.0)
 
+    def test_arms_evaluated_apart_merge_into_one_capacity_figure(self):
+        experiment_results.collect(self.out, self.s, self.pts)
+        rows = read_csv(self.out / "results.csv")
+        apart = {}
+        for arm in ("keep", "sumo_native"):  # as if each arm had been its own experiment
+            apart[arm] = self.out / ("only_" + arm + ".csv")
+            with open(apart[arm], "w", newline="") as f:
+                w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+                w.writeheader()
+                w.writerows(r for r in rows if r["arm"] == arm)
+        merged = self.out / "merged"
+        experiment_results.merge(merged, [apart["keep"], apart["sumo_native"]], [101, 102, 103], 600.0, "tiny")
+        cap = {(r["arm"], r["demand"], r["metric"]) for r in read_csv(merged / "figures" / "capacity.csv")}
+        self.assertEqual(len(cap), 2 * 2 * 2)  # both arms, both demands, speed and throughput
+        self.assertGreater((merged / "figures" / "capacity.png").stat().st_size, 10000)
+
     def test_without_sumo_native_jams_are_not_checked_and_old_folders_still_collect(self):
         s = experiment.settings_from_args(args(arms="keep", prs="60", seeds=2))  # no --demands
         out = self.out / "old"
