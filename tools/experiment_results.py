@@ -269,7 +269,10 @@ def draw_capacity(out, arms, prs, rows):
                     table.append([arm, f"{pr:g}", f"{demand:g}", key, len(vals), round(mean, 4),
                                   round(half, 4) if math.isfinite(half) else ""])
                 if xs:
-                    ax.errorbar(xs, ys, yerr=hs, marker="o", capsize=3, label=title(arm))
+                    # One colour per arm in every panel (a panel without some arm would
+                    # otherwise shift the others' colours).
+                    ax.errorbar(xs, ys, yerr=hs, marker="o", capsize=3, label=title(arm),
+                                color="C%d" % (arms.index(arm) % 10))
             ax.set_xlabel("mainline demand (veh/h per lane)")
             ax.set_ylabel(label)
             ax.set_title(f"PR {pr:g} %")
