@@ -117,7 +117,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
     lines = [
         f"# Training record of this policy ({train['arm']})",
         "",
-        f"- command: `{manifest.get('command_line', '(unknown)')}`",
+        f"- command: `{train.get('command_line') or manifest.get('command_line', '(unknown)')}`"
+        + "".join(f", continued with `{c}`" for c in train.get("resumed_with", [])),
         f"- road {train['scenario']}, {traffic_text(train)}, {train['episodes']} x {train['duration_s']:.0f} s, "
         f"exploration over {100 * float(train.get('explore_fraction', 0.5)):.0f} % of the budget"
         + (", paper as printed" if train.get("paper_printed") else ", config/departures.yaml"),

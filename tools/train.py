@@ -184,8 +184,18 @@ def as_number(value):
     return int(value) if isinstance(value, float) and value.is_integer() else value
 
 
-def write_record(out, opts, git_commit):
-    """train.json, written whole (a path with a quote or a backslash stays valid JSON)."""
+def write_record(out, opts, git_commit, command_line="", resume=False):
+    """train.json, written whole (a path with a quote or a backslash stays valid JSON). It
+    keeps the command that started the training (`command_line`) and lists every later
+    `--resume` in `resumed_with`, so a shipped policy names how it was trained, not only how
+    it was last continued."""
+    earlier = {}
+    if resume:
+        try:
+            with open(policy_folder.train_record_path(out)) as f:
+                earlier = json.load(f)
+        except (OSError, ValueError):
+            earlier = {}
     record = {"arm": opts["arm"], "scenario": opts["scenario"], "pr": as_number(opts["pr"]), "seed": opts["seed"],
               "episodes": opts["episodes"], "duration_s": as_number(opts["duration"]), "learning": opts.get("learning") or "",
               "rsu_params": opts.get("rsu_params") or "", "bridge_params": opts.get("bridge_params") or "",
@@ -194,7 +204,9 @@ def write_record(out, opts, git_commit):
               "demand_vphpl": as_number(opts["demand"]) if opts.get("demand") is not None else None,
               "ramp_demand_vph": as_number(opts["ramp_demand"]) if opts.get("ramp_demand") is not None else None,
               "demand_range": opts.get("demand_range"), "pr_range": opts.get("pr_range"),
-              "git_commit": git_commit}
+              "git_commit": git_commit,
+              "command_line": earlier.get("command_line", "") if resume else command_line,
+              "resumed_with": earlier.get("resumed_with", []) + ([command_line] if resume else [])}
     if sampled(opts):
         record["episode_draws"] = [episode_draw(opts, k) for k in range(int(opts["episodes"]))]
     tmp = os.path.join(out, ".train.json.tmp")
@@ -495,7 +507,7 @@ def main(argv=None):
             print("[palcas] error: bad --explore-fraction", file=sys.stderr)
             return 1
         opts["learning"] = schedule
-    record = write_record(out, opts, git_commit(args.root))
+    record = write_record(out, opts, git_commit(args.root), args.command_line, bool(args.resume))
     interrupt = Interrupt()
     status = run_launches(args.root, out, opts, record, args, interrupt)
     if status in (130, 143):

@@ -110,6 +110,18 @@ class Record(unittest.TestCase):
         self.assertEqual((record["pr"], record["duration_s"]), (60, 1200))
         self.assertIsInstance(record["pr"], int)
 
+    def test_the_starting_command_survives_every_resume(self):
+        out = tempfile.mkdtemp()
+        opts = dict(train.DEFAULTS, learning="", rsu_params="", bridge_params="", paper_printed=False)
+        train.write_record(out, opts, "abc", "./palcas train --arm palcas --episodes 36")
+        train.write_record(out, opts, "def", "./palcas train --resume --out x", resume=True)
+        train.write_record(out, opts, "def", "./palcas train --resume --out x --episodes 40", resume=True)
+        with open(os.path.join(out, "train.json")) as f:
+            record = json.load(f)
+        self.assertEqual(record["command_line"], "./palcas train --arm palcas --episodes 36")
+        self.assertEqual(record["resumed_with"], ["./palcas train --resume --out x",
+                                                  "./palcas train --resume --out x --episodes 40"])
+
     def test_message_key_is_made_once_and_owner_only(self):
         out = tempfile.mkdtemp()
         key = train.message_key(out)
@@ -347,6 +359,18 @@ class ShipPolicy(unittest.TestCase):
         self.assertEqual((dest / "bridge.yaml").read_text(), "cav_lane_change_mode: 1792\n")
         self.assertEqual(json.loads((dest / "train.json").read_text())["runs_with_bridge"], "bridge.yaml")
         self.assertIn("trained with: `bridge.yaml`", (dest / "TRAINING.md").read_text())
+
+    def test_training_md_names_the_starting_command_and_its_resumes(self):
+        src = self.training("")
+        record = json.loads((src / "train.json").read_text())
+        record.update(command_line="./palcas train --arm palcas --episodes 4",
+                      resumed_with=["./palcas train --resume --out train-x"])
+        (src / "train.json").write_text(json.dumps(record))
+        (src / "manifest.json").write_text(json.dumps({"command_line": "./palcas train --resume --out train-x"}))
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(src), str(dest), rsu_models=True)
+        self.assertIn("- command: `./palcas train --arm palcas --episodes 4`, continued with "
+                      "`./palcas train --resume --out train-x`", (dest / "TRAINING.md").read_text())
 
     def test_without_the_flag_a_policy_runs_under_the_default_bridge(self):
         bridge = pathlib.Path(tempfile.mkdtemp()) / "unclipped.yaml"
