@@ -118,15 +118,4 @@ metrics::AdvisoryRequest toRequest(const palcas_msgs::Advisory& a, std::uint64_t
   return r;
 }
 
-metrics::KnownVehicle toKnownVehicle(const sim::VehicleRecord* record, int num_lanes) {
-  metrics::KnownVehicle k;
-  k.num_lanes = num_lanes;
-  if (!record) return k;
-  k.exists = true;
-  k.is_cav = record->is_cav;
-  k.lane = record->lane;
-  k.on_accel_lane = record->on_accel_lane;
-  return k;
-}
-
 }  // namespace palcas::bridge

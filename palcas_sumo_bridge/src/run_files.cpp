@@ -140,14 +140,6 @@ json bridgeJson(const BridgeOptions& o) {
 
 }  // namespace
 
-void StepTimer::add(std::size_t vehicles, double sumo_s, double bridge_s, double lockstep_s) {
-  Bucket& b = buckets_[vehicles / BUCKET_WIDTH * BUCKET_WIDTH];
-  ++b.steps;
-  b.sumo_s += sumo_s;
-  b.bridge_s += bridge_s;
-  b.lockstep_s += lockstep_s;
-}
-
 std::string prepareScenario(const BridgeOptions& o) {
   const sim::ScenarioConfig& config = o.scenario;
   fs::create_directories(o.out_dir);

@@ -2,12 +2,14 @@
 // derived observation the metrics are computed from.
 #include "palcas_sumo_bridge/msg_conversion.h"
 
+#include "palcas_sim/episode_runner.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 
 using palcas::bridge::fromMsg;
-using palcas::bridge::toKnownVehicle;
+using palcas::sim::knownVehicle;
 using palcas::bridge::toMsg;
 using palcas::bridge::toObservation;
 namespace metrics = palcas::metrics;
@@ -143,9 +145,9 @@ TEST(MsgConversion, AdvisoryRequestAndKnownVehicle) {
   EXPECT_DOUBLE_EQ(r.accel_mps2, -1.25);
   EXPECT_EQ(r.answers_step, 77u);
   EXPECT_EQ(r.rsu_id, "rsu_2");
-  EXPECT_FALSE(toKnownVehicle(nullptr, 5).exists);
+  EXPECT_FALSE(knownVehicle(nullptr, 5).exists);
   const auto record = rampCav();
-  const auto k = toKnownVehicle(&record, 5);
+  const auto k = knownVehicle(&record, 5);
   EXPECT_TRUE(k.exists && k.is_cav && k.on_accel_lane);
   EXPECT_EQ(k.lane, 0);
   EXPECT_EQ(k.num_lanes, 5);

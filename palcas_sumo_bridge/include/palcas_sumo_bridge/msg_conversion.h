@@ -31,7 +31,4 @@ palcas_msgs::EpisodeMetrics toMsg(const metrics::EpisodeMetrics& m, double wall_
 metrics::AdvisoryRequest toRequest(const palcas_msgs::Advisory& advisory, std::uint64_t step,
                                    const std::string& rsu_id);
 
-/// What the validator knows of a vehicle (exists = false for nullptr).
-metrics::KnownVehicle toKnownVehicle(const sim::VehicleRecord* record, int num_lanes);
-
 }  // namespace palcas::bridge

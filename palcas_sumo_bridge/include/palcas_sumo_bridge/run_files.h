@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "palcas_sim/episode_runner.h"
 #include "palcas_sim/scenario.h"
 #include "palcas_sim/sumo_session.h"
 #include "palcas_sumo_bridge/bridge_options.h"
@@ -17,25 +18,7 @@
 
 namespace palcas::bridge {
 
-/// Cost per step against the number of vehicles on the road, in buckets of 50 vehicles:
-/// SUMO's own step (with reading the subscriptions), the bridge's work around it
-/// (conversion, publishing, measuring) and the lockstep (waiting for the RSUs' answers and
-/// applying them).
-class StepTimer {
- public:
-  void add(std::size_t vehicles, double sumo_s, double bridge_s, double lockstep_s);
-  struct Bucket {
-    std::uint64_t steps = 0;
-    double sumo_s = 0.0;
-    double bridge_s = 0.0;
-    double lockstep_s = 0.0;
-  };
-  const std::map<std::size_t, Bucket>& buckets() const { return buckets_; }
-  static constexpr std::size_t BUCKET_WIDTH = 50;
-
- private:
-  std::map<std::size_t, Bucket> buckets_;  ///< key = first vehicle count of the bucket
-};
+using StepTimer = sim::StepTimer;
 
 struct RunSummary {
   int episode = 0;
