@@ -36,17 +36,17 @@ FedServerNode::FedServerNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   diagnostics_.setHardwareID("palcas_fedserver");
   diagnostics_.add("federation", this, &FedServerNode::diagnose);
   const FederationOptions& f = options_.federation;
-  ROS_INFO("palcas fedserver: round %u, global version %u (%zu values, layout %s), %zu RSU(s) "
+  ROS_INFO_NAMED("startup", "palcas fedserver: round %u, global version %u (%zu values, layout %s), %zu RSU(s) "
            "expected, quorum %zu, deadline %.1f s, liveness %.1f s, checkpoints %s",
            server_.round(), server_.globalVersion(), server_.globalModel()->values.size(),
            server_.globalModel()->layout_id.c_str(), f.expected_rsus.size(), f.effectiveQuorum(),
            f.round_deadline_s, f.liveness_timeout_s,
            options_.checkpoint_dir.empty() ? "off" : options_.checkpoint_dir.c_str());
   if (auth_key_)
-    ROS_INFO("palcas fedserver: submissions authenticated with key %s (fingerprint %s)",
+    ROS_INFO_NAMED("startup", "palcas fedserver: submissions authenticated with key %s (fingerprint %s)",
              options_.auth_key_file.c_str(), auth_key_->fingerprint().c_str());
   else
-    ROS_WARN("palcas fedserver: ~auth_key_file not set: submissions are NOT authenticated");
+    ROS_WARN_NAMED("startup", "palcas fedserver: ~auth_key_file not set: submissions are NOT authenticated");
 }
 
 void FedServerNode::takeStateSizeFromTheRoad() {
@@ -57,7 +57,7 @@ void FedServerNode::takeStateSizeFromTheRoad() {
                              common::ROAD_LANES_PARAM + " within ~road_wait_s = " +
                              std::to_string(options_.road_wait_s) + " s");
   options_.learning.state_size = StateLayout(road->num_lanes).size();
-  ROS_INFO("palcas fedserver: state size %d (%d + the road's %d lanes)", options_.learning.state_size,
+  ROS_INFO_NAMED("startup", "palcas fedserver: state size %d (%d + the road's %d lanes)", options_.learning.state_size,
            LANE_INDEPENDENT_FEATURE_COUNT, road->num_lanes);
 }
 
@@ -71,7 +71,7 @@ void FedServerNode::initializeModel() {
     // A training that stopped before the first round closed has nothing to resume: start
     // from the initial model (the RSUs do the same), and say so.
     if (options_.resume)
-      ROS_INFO("palcas fedserver: no checkpoint in %s yet; starting afresh",
+      ROS_INFO_NAMED("checkpoint", "palcas fedserver: no checkpoint in %s yet; starting afresh",
                options_.checkpoint_dir.c_str());
     server_.initialize(agent.exportModel());
     return;
@@ -81,7 +81,7 @@ void FedServerNode::initializeModel() {
     throw std::runtime_error("checkpoint " + options_.checkpoint_dir + " holds layout '" +
                              server_.globalModel()->layout_id + "', ~learning/* gives '" +
                              agent.layoutId() + "'");
-  ROS_INFO("palcas fedserver: resumed from %s", options_.checkpoint_dir.c_str());
+  ROS_INFO_NAMED("checkpoint", "palcas fedserver: resumed from %s", options_.checkpoint_dir.c_str());
 }
 
 bool FedServerNode::onSubmit(palcas_msgs::SubmitWeights::Request& req,
@@ -95,12 +95,15 @@ bool FedServerNode::onSubmit(palcas_msgs::SubmitWeights::Request& req,
                                w.rsu_id + "'")
           : server_.submit(w.rsu_id, w.round, w.model_version, common::toModelBlob(w),
                            w.sample_count, nowS());
+  ROS_DEBUG_NAMED("submissions", "palcas fedserver: submission from '%s': round %u, model v%u, %zu values, n_k %lu, "
+                  "%s: %s", w.rsu_id.c_str(), w.round, w.model_version, w.values.size(),
+                  static_cast<unsigned long>(w.sample_count), auth::verdictName(verdict), r.accepted ? "accepted" : r.reason.c_str());
   if (r.accepted) {
-    ROS_INFO("palcas fedserver: round %u: model from '%s' (n_k %lu)", w.round, w.rsu_id.c_str(),
+    ROS_INFO_NAMED("rounds", "palcas fedserver: round %u: model from '%s' (n_k %lu)", w.round, w.rsu_id.c_str(),
              static_cast<unsigned long>(w.sample_count));
     pollAndReport();  // the last live RSU closes the round at once, not at the next tick
   } else {
-    ROS_WARN("palcas fedserver: refused a model from '%s': %s", w.rsu_id.c_str(), r.reason.c_str());
+    ROS_WARN_NAMED("rounds", "palcas fedserver: refused a model from '%s': %s", w.rsu_id.c_str(), r.reason.c_str());
   }
   res.accepted = r.accepted;
   res.reason = r.reason;
@@ -122,8 +125,12 @@ bool FedServerNode::onFetch(palcas_msgs::FetchGlobalModel::Request& req,
     res.weights = common::toWeightsMsg(*r.model, SERVER_ID, r.round, r.global_version, 0);
     common::signMessage(res.weights, auth_key_.get());
   }
+  const std::string answer =
+      r.available ? "global v" + std::to_string(r.global_version) + " of round " + std::to_string(r.round) : r.reason;
+  ROS_DEBUG_NAMED("fetches", "palcas fedserver: fetch by '%s' (wants v%u): %s", req.rsu_id.c_str(), req.min_version,
+                  answer.c_str());
   if (server_.status().fetch_unknown_rsu != unknown_before) {
-    ROS_WARN("palcas fedserver: %s", r.reason.c_str());
+    ROS_WARN_NAMED("rounds", "palcas fedserver: %s", r.reason.c_str());
     publishStatus();
   }
   return true;
@@ -180,18 +187,18 @@ void FedServerNode::pollAndReport() {
   std::ostringstream counts;
   for (const auto& [id, n] : rr.sample_counts) counts << ' ' << id << '=' << n;
   if (rr.aggregated)
-    ROS_INFO("palcas fedserver: round %u closed (%s): global version %u, n_k:%s, %.2f s, %lu bytes in",
+    ROS_INFO_NAMED("rounds", "palcas fedserver: round %u closed (%s): global version %u, n_k:%s, %.2f s, %lu bytes in",
              rr.round, rr.on_deadline ? "deadline with quorum" : "every live RSU submitted",
              rr.global_version, counts.str().c_str(), rr.duration_s,
              static_cast<unsigned long>(rr.bytes_in));
   else
-    ROS_ERROR("palcas fedserver: round %u closed but its average is not finite: global version "
+    ROS_ERROR_NAMED("rounds", "palcas fedserver: round %u closed but its average is not finite: global version "
               "%u kept, n_k:%s", rr.round, rr.global_version, counts.str().c_str());
   if (!options_.checkpoint_dir.empty()) {
     try {
       server_.saveCheckpoint(options_.checkpoint_dir);
     } catch (const std::runtime_error& e) {  // keep federating; the next round retries
-      ROS_ERROR("palcas fedserver: checkpoint failed: %s", e.what());
+      ROS_ERROR_NAMED("checkpoint", "palcas fedserver: checkpoint failed: %s", e.what());
     }
   }
   std_msgs::UInt32 version;

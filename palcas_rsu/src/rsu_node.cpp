@@ -9,6 +9,7 @@
 #include <palcas_msgs/RegisterRsu.h>
 #include <palcas_msgs/RsuStatus.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 
@@ -80,10 +81,10 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   const RsuControllerOptions& c = options_.controller;
   if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
     // A new training, or one that stopped before this RSU wrote anything: start afresh.
-    ROS_INFO("%s: no checkpoint in %s yet; starting afresh", c.rsu_id.c_str(), checkpointDir().c_str());
+    ROS_INFO_NAMED("checkpoint", "%s: no checkpoint in %s yet; starting afresh", c.rsu_id.c_str(), checkpointDir().c_str());
   } else if (options_.resume) {
     controller_->loadCheckpoint(checkpointDir());
-    ROS_INFO("%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
+    ROS_INFO_NAMED("checkpoint", "%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
              checkpointDir().c_str(), static_cast<unsigned long>(controller_->agent().gradientSteps()),
              controller_->modelVersion());
   }
@@ -105,7 +106,7 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   diagnostics_.add("decisions", this, &RsuNode::diagnose);
   waitForPeers();
   registerWithBridge();
-  ROS_INFO("%s: cluster %d [%.0f, %.0f) m, %s, decides every %d step(s), federation %s, I2I %s",
+  ROS_INFO_NAMED("startup", "%s: cluster %d [%.0f, %.0f) m, %s, decides every %d step(s), federation %s, I2I %s",
            c.rsu_id.c_str(), c.cluster_index, c.x_start_m, c.x_end_m, c.train ? "train" : "eval",
            options_.decision_period_steps, options_.federation ? "on" : "off", options_.i2i ? "on" : "off");
 }
@@ -117,7 +118,7 @@ std::string RsuNode::checkpointDir() const {
 void RsuNode::loadInitialModel() {
   const RsuControllerOptions& c = options_.controller;
   if (!c.train && options_.policy_dir == RANDOM_POLICY)
-    ROS_WARN("%s: evaluating an UNTRAINED network (policy_dir:=%s): its advice is random", c.rsu_id.c_str(),
+    ROS_WARN_NAMED("startup", "%s: evaluating an UNTRAINED network (policy_dir:=%s): its advice is random", c.rsu_id.c_str(),
              RANDOM_POLICY);
   if (!c.train && options_.policy_dir != RANDOM_POLICY) {
     // A federated policy is the server's global model; an independent one is per RSU; an RSU
@@ -135,7 +136,7 @@ void RsuNode::loadInitialModel() {
     const fs::path file = *found;
     controller_->loadPolicy(file.string());
     policy_file_ = file.string();
-    ROS_INFO("%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
+    ROS_INFO_NAMED("startup", "%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
     return;
   }
   if (!options_.federation) return;
@@ -149,7 +150,7 @@ void RsuNode::loadInitialModel() {
       [this](FederationEvent e, const std::string& message) { onFederationEvent(e, message); });
   if (!ros::service::waitForService(nh_.resolveName(FETCH_MODEL_SERVICE),
                                     ros::Duration(options_.federation_wait_s))) {
-    ROS_WARN("%s: federation server not reachable after %.0f s: starting from local weights; "
+    ROS_WARN_NAMED("federation", "%s: federation server not reachable after %.0f s: starting from local weights; "
              "will join when it answers", c.rsu_id.c_str(), options_.federation_wait_s);
     return;
   }
@@ -184,7 +185,7 @@ void RsuNode::waitForPeers() {
           cluster_sub_.getNumPublishers() < links))
     ros::WallDuration(0.02).sleep();
   if (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links)
-    ROS_WARN("%s: I2I: %u of %u peers connected after %.0f s; starting anyway (their states "
+    ROS_WARN_NAMED("i2i", "%s: I2I: %u of %u peers connected after %.0f s; starting anyway (their states "
              "count as unknown until they arrive)", options_.controller.rsu_id.c_str(),
              std::min(cluster_pub_.getNumSubscribers(), cluster_sub_.getNumPublishers()) - 1, peers,
              options_.register_timeout_s);
@@ -193,7 +194,7 @@ void RsuNode::waitForPeers() {
 void RsuNode::registerWithBridge() {
   ros::ServiceClient client = nh_.serviceClient<palcas_msgs::RegisterRsu>(REGISTER_RSU_SERVICE);
   if (!client.waitForExistence(ros::Duration(options_.register_timeout_s))) {
-    ROS_WARN("%s: bridge's %s not available after %.0f s; answering states as they come",
+    ROS_WARN_NAMED("startup", "%s: bridge's %s not available after %.0f s; answering states as they come",
              options_.controller.rsu_id.c_str(), nh_.resolveName(REGISTER_RSU_SERVICE).c_str(),
              options_.register_timeout_s);
     return;
@@ -208,7 +209,7 @@ void RsuNode::registerWithBridge() {
   palcas_msgs::RegisterRsu srv;
   srv.request.rsu_id = options_.controller.rsu_id;
   if (!client.call(srv) || !srv.response.accepted)
-    ROS_WARN("%s: registration refused: %s", options_.controller.rsu_id.c_str(),
+    ROS_WARN_NAMED("startup", "%s: registration refused: %s", options_.controller.rsu_id.c_str(),
              srv.response.reason.c_str());
 }
 
@@ -228,14 +229,14 @@ void RsuNode::onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
   try {
     peers_.update(msg->cluster_index, msg->rsu_id, msg->density_veh_per_km, msg->header.stamp.toSec());
   } catch (const std::invalid_argument& e) {
-    ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", options_.controller.rsu_id.c_str(), e.what());
+    ROS_WARN_THROTTLE_NAMED(5.0, "i2i", "%s: ignored cluster state: %s", options_.controller.rsu_id.c_str(), e.what());
   }
 }
 
 void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
   const ros::WallTime received = ros::WallTime::now();
   if (first_state_ && msg->num_lanes != options_.controller.num_lanes) {
-    ROS_FATAL("%s: the road has %u lanes but rsu/num_lanes is %d (the state size depends on it)",
+    ROS_FATAL_NAMED("startup", "%s: the road has %u lanes but rsu/num_lanes is %d (the state size depends on it)",
               options_.controller.rsu_id.c_str(), msg->num_lanes, options_.controller.num_lanes);
     ros::shutdown();
     return;
@@ -248,7 +249,7 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     if (options_.whole_road) p.rsu_range_m = std::numeric_limits<double>::infinity();
     channel_ = std::make_unique<v2x::Channel>(p, msg->step_length_s);
     uplink_ = std::make_unique<v2x::UplinkView>(*channel_, c.rsu_id, x_m);
-    ROS_INFO("%s: V2X channel on (seed %lu): states %.3f s + U(0, %.3f) s, lost %.1f %%; cluster states %.3f s + "
+    ROS_INFO_NAMED("v2x", "%s: V2X channel on (seed %lu): states %.3f s + U(0, %.3f) s, lost %.1f %%; cluster states %.3f s + "
              "U(0, %.3f) s, lost %.1f %%; range %.1f m from x = %.0f m; states forgotten after %.2f s",
              c.rsu_id.c_str(), static_cast<unsigned long>(p.seed), p.vehicle_state.latency_s, p.vehicle_state.jitter_s,
              100.0 * p.vehicle_state.loss_probability, p.cluster_state.latency_s, p.cluster_state.jitter_s,
@@ -271,7 +272,7 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
       const RoadSnapshot road = heard(*msg);  // the uplink hears every step
       if (observe) controller_->observeStep(road);  // never touches the agent: no join
     } catch (const std::invalid_argument& e) {
-      ROS_ERROR_THROTTLE(5.0, "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
+      ROS_ERROR_THROTTLE_NAMED(5.0, "decision", "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
                          static_cast<unsigned long>(msg->step), e.what());
     }
   }
@@ -302,12 +303,13 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallT
     decision = advise(msg, now_s, global);
   } catch (const std::invalid_argument& e) {
     // A malformed state: answer empty (CAVs keep their commands), say why, keep going.
-    ROS_ERROR_THROTTLE(5.0, "%s: step %lu not decided: %s", options_.controller.rsu_id.c_str(),
+    ROS_ERROR_THROTTLE_NAMED(5.0, "decision", "%s: step %lu not decided: %s", options_.controller.rsu_id.c_str(),
                        static_cast<unsigned long>(msg.step), e.what());
     answerEmpty(msg, received);
     return;
   }
   const float decision_ms = publishDecision(msg, decision, global, received);
+  logDecisionDetail(msg.step, decision, global, decision_ms);
   const AfterDecision after = schedule_.decided();
   if (after.learn_inline) controller_->learn();  // after publishing: the bridge need not wait
   logDecision(msg.step, decision_ms);
@@ -325,7 +327,7 @@ DecisionOutput RsuNode::advise(const palcas_msgs::VehicleStateArray& msg, double
     try {
       peers_.update(m.cluster_index, m.rsu_id, m.density_veh_per_km, m.header.stamp.toSec());
     } catch (const std::invalid_argument& e) {
-      ROS_WARN_THROTTLE(5.0, "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
+      ROS_WARN_THROTTLE_NAMED(5.0, "i2i", "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
     }
   }
   // The own density is not known before deciding; the state builder takes the global
@@ -357,11 +359,29 @@ float RsuNode::publishDecision(const palcas_msgs::VehicleStateArray& msg, const 
   return out.decision_ms;
 }
 
+void RsuNode::logDecisionDetail(std::uint64_t step, const DecisionOutput& decision, const GlobalDensities& global,
+                                float decision_ms) const {
+  const RsuControllerStats stats = controller_->stats();
+  std::string advice;
+  for (const CavAdvisory& a : decision.advisories) {
+    advice += " " + a.vehicle_id + ":" + actionName(a.decision.action);
+    if (a.decision.action == Action::kAccelerate) {
+      char accel[16];
+      std::snprintf(accel, sizeof accel, "(%+.2f)", a.decision.accel_mps2);
+      advice += accel;
+    }
+  }
+  ROS_DEBUG_NAMED("decision", "%s: step %lu: %u members, density %.1f veh/km (I2I up %.1f, down %.1f), model v%u, "
+                  "%.2f ms;%s", options_.controller.rsu_id.c_str(), static_cast<unsigned long>(step), stats.member_count,
+                  decision.cluster.density_veh_per_km, global.upstream, global.downstream, decision.model_version,
+                  decision_ms, advice.c_str());
+}
+
 void RsuNode::logDecision(std::uint64_t step, float decision_ms) {
   try {
     learning_log_.addDecision(step, controller_->stats(), decision_ms);
   } catch (const std::runtime_error& e) {
-    ROS_ERROR_THROTTLE(60.0, "%s: %s", options_.controller.rsu_id.c_str(), e.what());
+    ROS_ERROR_THROTTLE_NAMED(60.0, "learning", "%s: %s", options_.controller.rsu_id.c_str(), e.what());
   }
 }
 
@@ -397,14 +417,14 @@ void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
 void RsuNode::onFederationEvent(FederationEvent event, const std::string& message) {
   // One log call per kind, so each kind is throttled on its own.
   switch (event) {
-    case FederationEvent::kUnreachable: ROS_WARN_THROTTLE(10.0, "%s", message.c_str()); break;
-    case FederationEvent::kModelRefused: ROS_ERROR_THROTTLE(10.0, "%s", message.c_str()); break;
-    case FederationEvent::kSubmitRefused: ROS_WARN_THROTTLE(10.0, "%s", message.c_str()); break;
-    case FederationEvent::kSubmitted: ROS_INFO("%s", message.c_str()); break;
+    case FederationEvent::kUnreachable: ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
+    case FederationEvent::kModelRefused: ROS_ERROR_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
+    case FederationEvent::kSubmitRefused: ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
+    case FederationEvent::kSubmitted: ROS_INFO_NAMED("federation", "%s", message.c_str()); break;
     case FederationEvent::kLoaded:
       model_pub_.publish(common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
                                               federation_->openRound(), controller_->modelVersion(), 0));
-      ROS_INFO("%s", message.c_str());
+      ROS_INFO_NAMED("federation", "%s", message.c_str());
       break;
   }
 }
@@ -414,7 +434,7 @@ void RsuNode::checkpoint() {
     controller_->saveCheckpoint(checkpointDir());
     controller_->agent().saveModel((fs::path(checkpointDir()) / "model.palcas").string());
   } catch (const std::exception& e) {
-    ROS_ERROR("%s: checkpoint failed: %s", options_.controller.rsu_id.c_str(), e.what());
+    ROS_ERROR_NAMED("checkpoint", "%s: checkpoint failed: %s", options_.controller.rsu_id.c_str(), e.what());
   }
 }
 
@@ -422,7 +442,7 @@ void RsuNode::endEpisodeLog() {
   try {
     learning_log_.endEpisode(controller_->stats());
   } catch (const std::runtime_error& e) {
-    ROS_ERROR("%s: %s", options_.controller.rsu_id.c_str(), e.what());
+    ROS_ERROR_NAMED("learning", "%s: %s", options_.controller.rsu_id.c_str(), e.what());
   }
 }
 
@@ -449,7 +469,7 @@ void RsuNode::shutdown() {
   endEpisodeLog();
   if (options_.controller.train && !options_.checkpoint_dir.empty()) {
     checkpoint();
-    ROS_INFO("%s: checkpoint written to %s", options_.controller.rsu_id.c_str(), checkpointDir().c_str());
+    ROS_INFO_NAMED("checkpoint", "%s: checkpoint written to %s", options_.controller.rsu_id.c_str(), checkpointDir().c_str());
   }
 }
 

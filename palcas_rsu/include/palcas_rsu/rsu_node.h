@@ -54,6 +54,9 @@ class RsuNode {
                         const GlobalDensities& global, const ros::WallTime& received);
   /// The decision's row of the learning log (errors logged, not thrown).
   void logDecision(std::uint64_t step, float decision_ms);
+  /// DEBUG on logger "decision": members, densities and every advisory of one decision.
+  void logDecisionDetail(std::uint64_t step, const DecisionOutput& decision, const GlobalDensities& global,
+                         float decision_ms) const;
   /// The decision's RsuStatus (msg_conversion's toStatusMsg) and the diagnostics.
   void publishStatus(const palcas_msgs::VehicleStateArray& msg, double now_s, float decision_ms);
   void answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
