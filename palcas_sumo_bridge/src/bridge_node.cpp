@@ -69,14 +69,14 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   publishRoad();  // before registration opens: an RSU checks its zone when it registers
   register_srv_ = nh_.advertiseService(REGISTER_RSU_SERVICE, &BridgeNode::onRegister, this);
   setUpDiagnostics();
-  ROS_INFO("palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
+  ROS_INFO_NAMED("startup", "palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
            session().sumoVersion().c_str(), sim::SumoSession::apiName(), sumocfg_path_.c_str(),
            100.0 * options_.scenario.penetration_rate, options_.scenario.seed, options_.scenario.duration_s, options_.expected_rsus.size());
   if (auth_key_)
-    ROS_INFO("palcas bridge: advisories authenticated with key %s (fingerprint %s)",
+    ROS_INFO_NAMED("startup", "palcas bridge: advisories authenticated with key %s (fingerprint %s)",
              options_.auth_key_file.c_str(), auth_key_->fingerprint().c_str());
   else if (!options_.expected_rsus.empty() || options_.session.advisory_control)
-    ROS_WARN("palcas bridge: ~auth_key_file not set: advisories are NOT authenticated, any "
+    ROS_WARN_NAMED("startup", "palcas bridge: ~auth_key_file not set: advisories are NOT authenticated, any "
              "publisher on %s can steer CAVs", ADVISORIES_TOPIC);
 }
 
@@ -119,8 +119,8 @@ bool BridgeNode::onRegister(palcas_msgs::RegisterRsu::Request& req,
   res.accepted = runner_->lockstep().registerRsu(req.rsu_id, &reason);
   res.reason = reason;
   res.next_step = session().stepCount();
-  if (res.accepted) ROS_INFO("palcas bridge: RSU '%s' registered", req.rsu_id.c_str());
-  else ROS_WARN("palcas bridge: refused registration: %s", reason.c_str());
+  if (res.accepted) ROS_INFO_NAMED("startup", "palcas bridge: RSU '%s' registered", req.rsu_id.c_str());
+  else ROS_WARN_NAMED("startup", "palcas bridge: refused registration: %s", reason.c_str());
   return true;
 }
 
@@ -139,13 +139,13 @@ bool BridgeNode::waitForPeers() {
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
   }
   if (states_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.min_subscribers))
-    ROS_WARN("palcas bridge: starting with %u of %d expected subscribers of %s after %.1f s",
+    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %d expected subscribers of %s after %.1f s",
              states_pub_.getNumSubscribers(), options_.min_subscribers, VEHICLE_STATES_TOPIC,
              options_.startup_timeout_s);
   if (runner_->lockstep().allRegistered()) return true;
   std::string missing;
   for (const std::string& id : runner_->lockstep().unregistered()) missing += " " + id;
-  ROS_WARN("palcas bridge: starting without RSU(s)%s: not registered after %.1f s; they are "
+  ROS_WARN_NAMED("startup", "palcas bridge: starting without RSU(s)%s: not registered after %.1f s; they are "
            "waited for once they answer",
            missing.c_str(), options_.startup_timeout_s);
   return false;
@@ -213,13 +213,13 @@ void BridgeNode::onAdvisories(const ros::MessageEvent<const palcas_msgs::Advisor
   for (const palcas_msgs::Advisory& a : msg->advisories) array->advisories.push_back(toRequest(a, msg->step, msg->rsu_id));
   const sim::EpisodeRunner::AnswerOutcome outcome = runner_->onAnswer(std::move(array));
   for (const std::string& id : outcome.revived)
-    ROS_WARN("palcas bridge: RSU '%s' answers again (step %lu): waited for from the next step "
+    ROS_WARN_NAMED("lockstep", "palcas bridge: RSU '%s' answers again (step %lu): waited for from the next step "
              "on", id.c_str(), static_cast<unsigned long>(msg->step));
   if (outcome.verdict == sim::EpisodeRunner::Verdict::kDuplicate)
-    ROS_WARN_THROTTLE(5.0, "palcas bridge: second answer of RSU '%s' for step %lu ignored",
+    ROS_WARN_THROTTLE_NAMED(5.0, "lockstep", "palcas bridge: second answer of RSU '%s' for step %lu ignored",
                       msg->rsu_id.c_str(), static_cast<unsigned long>(msg->step));
   if (outcome.verdict == sim::EpisodeRunner::Verdict::kUnknownRsu)
-    ROS_WARN_THROTTLE(5.0, "palcas bridge: advisories from unknown RSU '%s' ignored "
+    ROS_WARN_THROTTLE_NAMED(5.0, "lockstep", "palcas bridge: advisories from unknown RSU '%s' ignored "
                       "(not in ~expected_rsus)", msg->rsu_id.c_str());
 }
 
@@ -229,13 +229,14 @@ void BridgeNode::lockstepMissed(std::uint64_t step, const std::vector<std::strin
     measure_->metrics().addLateRsuStep();
     std::string names;
     for (const std::string& id : late) names += " " + id;
-    ROS_WARN_THROTTLE(5.0, "palcas bridge: step %lu: RSU(s)%s missed the %.3f s deadline; their "
+    ROS_DEBUG_NAMED("lockstep", "palcas bridge: step %lu: late:%s", static_cast<unsigned long>(step), names.c_str());
+    ROS_WARN_THROTTLE_NAMED(5.0, "lockstep", "palcas bridge: step %lu: RSU(s)%s missed the %.3f s deadline; their "
                       "CAVs keep their speed (%lu late steps so far)",
                       static_cast<unsigned long>(step), names.c_str(), options_.lockstep_deadline_s,
                       static_cast<unsigned long>(runner_->lockstep().lateSteps()));
   }
   for (const std::string& id : newly_lost)
-    ROS_ERROR("palcas bridge: RSU '%s' lost after %d missed steps; continuing without it until "
+    ROS_ERROR_NAMED("lockstep", "palcas bridge: RSU '%s' lost after %d missed steps; continuing without it until "
               "it answers again", id.c_str(), options_.lost_after_missed_steps);
 }
 
@@ -255,13 +256,20 @@ void BridgeNode::reject(const std::string& rsu_id, const std::string& vehicle_id
   r.reason = static_cast<uint8_t>(reason);
   r.detail = detail;
   rejections_pub_.publish(r);
-  ROS_WARN_THROTTLE(2.0, "palcas bridge: rejected advisory from '%s' for '%s': %s (%s)",
+  ROS_DEBUG_NAMED("advice", "palcas bridge: step %lu: rejected advisory from '%s' for '%s': %s (%s)",
+                  static_cast<unsigned long>(r.step), rsu_id.c_str(), vehicle_id.c_str(),
+                  metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(reason)).c_str(), detail.c_str());
+  ROS_WARN_THROTTLE_NAMED(2.0, "advice", "palcas bridge: rejected advisory from '%s' for '%s': %s (%s)",
                     rsu_id.c_str(), vehicle_id.c_str(),
                     metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(reason)).c_str(),
                     detail.c_str());
 }
 
-void BridgeNode::applied(const std::string&) { measure_->metrics().addAdvisoriesApplied(); }
+void BridgeNode::applied(const std::string& vehicle_id) {
+  measure_->metrics().addAdvisoriesApplied();
+  ROS_DEBUG_NAMED("advice", "palcas bridge: step %lu: advisory for '%s' carried out",
+                  static_cast<unsigned long>(session().stepCount()), vehicle_id.c_str());
+}
 
 void BridgeNode::actuated(const sim::SumoSession& session, const sim::AdvisoryHolds& holds) {
   if (session.stepCount() % static_cast<std::uint64_t>(options_.markers_every_steps) != 0 ||
@@ -302,7 +310,7 @@ void BridgeNode::writeEpisode(int episode, const sim::EpisodeRun& run) {
   summary.insertion_dropped = session().insertionDropped();
   summary.downlink = run.downlink;
   writeMetricsJson(options_, summary, episode);
-  ROS_INFO("palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
+  ROS_INFO_NAMED("episode", "palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,
            options_.first_episode + options_.episodes, session().timeS(), summary.wall_seconds, options_.out_dir.c_str());
 }
 

@@ -83,7 +83,7 @@ void BridgeNode::progress(const sim::SumoSession& session) {
   const int episodes_left = options_.first_episode + options_.episodes - episode_;
   const double remaining_sim_s = options_.scenario.duration_s * episodes_left - msg.sim_seconds;
   const double left_s = msg.real_time_factor > 0.0 ? remaining_sim_s / msg.real_time_factor : 0.0;
-  ROS_INFO("palcas bridge: episode %d/%d  t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
+  ROS_INFO_NAMED("episode", "palcas bridge: episode %d/%d  t=%6.0f/%.0f s  on road %4u  speed %5.2f m/s (CAV %5.2f)  CR %5.2f%%  "
            "DSR %5.1f%%  MSR %5.1f%%  RTF %5.1fx  ~%.0f s left",
            episode_ + 1, options_.first_episode + options_.episodes, msg.sim_seconds, options_.scenario.duration_s, msg.vehicles_on_road, msg.efficiency_all_mps,
            msg.efficiency_cav_mps, msg.collision_rate_pct, msg.dsr_pct, msg.msr_pct,
