@@ -1,12 +1,12 @@
 """The commands and their dispatch: `python3 tools/palcas_cli COMMAND ARGS...` runs one,
 `python3 tools/palcas_cli check COMMAND ARGS...` only checks its options (what ./palcas does
 before it installs or builds anything)."""
+import importlib
 import sys
 
-from palcas_cli import experiment, replay, run, train
 from palcas_cli.options import OptionError
 
-COMMANDS = {"run": run, "train": train, "experiment": experiment, "replay": replay}
+COMMANDS = ("run", "train", "experiment", "replay")  # modules of this package
 # Exit status of `check`: the options are good and the command needs the built, sourced
 # workspace (BUILD) or nothing at all (NO_BUILD: planning or collecting an experiment).
 BUILD, NO_BUILD, BAD_OPTION = 0, 3, 2
@@ -14,7 +14,7 @@ USAGE = "usage: palcas_cli [check] %s ARGS... (see ./palcas help)" % "|".join(CO
 
 
 def check(command, argv):
-    module = COMMANDS[command]
+    module = importlib.import_module("palcas_cli." + command)
     try:
         needs_workspace = module.needs_workspace(argv) if hasattr(module, "needs_workspace") else bool(
             module.check(argv) or True)
@@ -32,7 +32,7 @@ def main(argv):
     try:
         if checking:
             return check(words[0], words[1:])
-        return COMMANDS[words[0]].main(words[1:])
+        return importlib.import_module("palcas_cli." + words[0]).main(words[1:])
     except OptionError as e:
         print("%s error: %s" % (e.prefix, e), file=sys.stderr)
         return BAD_OPTION

@@ -163,6 +163,8 @@ class Launch:
         self.port, self.process, self._offset, self._partial = None, None, 0, ""
 
     def start(self):
+        if interrupted():  # the command was stopped before this launch: none starts
+            raise Interrupted(interrupted())
         self.port = free_port()
         mode = "a" if self.append else "w"
         with open(self.console, mode) as console:

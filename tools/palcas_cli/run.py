@@ -125,7 +125,10 @@ def execute(p, console=None, show=launch.SHOWN):
     console = console or Console()
     rviz = RvizWindow(console)
     try:
-        return run_arms(p, console, show, rviz)
+        status = run_arms(p, console, show, rviz)
+        if launch.interrupted():  # stopped after its last launch: not a whole run either
+            raise launch.Interrupted(launch.interrupted())
+        return status
     except launch.Interrupted as stop:
         rviz.close()
         console.log("interrupted (%s): every node of this run stopped" % stop.signal)

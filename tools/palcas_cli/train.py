@@ -29,10 +29,8 @@ import sys
 
 from palcas_cli import Console, launch, options
 from palcas_cli.options import OptionError
-import learning_curves
 import palcas_arms
 import policy_folder
-import train_schedule
 
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
@@ -369,6 +367,7 @@ def main(argv):
         # The exploration schedule is a share of this training's budget, not of a 72-hour run.
         schedule = os.path.join(out, "learning_schedule.yaml")
         try:
+            import train_schedule  # PyYAML: installed by then
             train_schedule.write(schedule, opts["episodes"], opts["duration"], opts["explore_fraction"],
                                  base=opts["learning"])
         except Exception as e:  # noqa: BLE001 - a bad base file, named with its fault
@@ -387,6 +386,7 @@ def main(argv):
         console.error("training wrote no episodes.csv (see %s/console.log)" % out)
         return 1
     try:
+        import learning_curves  # matplotlib: only once there is something to draw
         learning_curves.main(out)
     except Exception as e:  # noqa: BLE001 - the training stands without its curves
         log("warning: no learning curves (%s)" % e)
