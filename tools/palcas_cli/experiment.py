@@ -30,7 +30,7 @@ import threading
 import time
 import traceback
 
-from palcas_cli import Console, ROOT, launch, run
+from palcas_cli import Console, ROOT, launch, options, run
 from palcas_cli.options import OptionError
 import experiment_results
 import policy_folder
@@ -40,7 +40,6 @@ PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.
 FIXED_KEYS = ("duration_s", "scenario", "v2x")
-MAX_DEMAND = 100000.0  # veh/h per lane: what the bridge accepts
 
 
 class UsageError(OptionError):
@@ -76,13 +75,6 @@ def training_seeds(policy_dir):
     return set(range(int(t["seed"]), int(t["seed"]) + int(t["episodes"])))
 
 
-def state_size(scenario):
-    """40 + the road's lane count (road/num_lanes of the scenario's scenario.yaml)."""
-    import yaml
-    f = ROOT / "config" / "scenarios" / scenario / "scenario.yaml"
-    return 40 + int(yaml.safe_load(f.read_text())["road"]["num_lanes"])
-
-
 def settings_from_args(a):
     arms = parse_list(a.arms, "arms", str)
     for arm in arms:
@@ -96,13 +88,13 @@ def settings_from_args(a):
     if a.demands is not None:
         demands = parse_list(a.demands, "demands", float)
         for d in demands:
-            if not 0.0 < d <= MAX_DEMAND:
-                raise UsageError(f"--demands: {d:g} is outside (0, {MAX_DEMAND:g}] veh/h per lane")
+            if not 0.0 < d <= options.MAX_DEMAND:
+                raise UsageError(f"--demands: {d:g} is outside (0, {options.MAX_DEMAND:g}] veh/h per lane")
     if a.seeds < 1:
         raise UsageError(f"--seeds: {a.seeds} must be >= 1")
     if not a.duration > 0:
         raise UsageError(f"--duration: {a.duration} must be > 0")
-    if not (ROOT / "config" / "scenarios" / a.scenario / "scenario.yaml").exists():
+    if not (options.SCENARIOS / a.scenario / "scenario.yaml").exists():
         raise UsageError(f"--scenario: no road '{a.scenario}' under config/scenarios")
     policies = {}
     for item in a.policy or []:
@@ -119,10 +111,10 @@ def settings_from_args(a):
             raise UsageError(f"arm '{arm}': no trained policy at {policy} (train it with "
                              f"./palcas train --arm {arm}, or pass --policy {arm}=DIR)")
         learnt_on = policy_folder.train_record(policy)["scenario"]
-        if state_size(learnt_on) != state_size(a.scenario):
+        have, need = options.scenario_state_size(learnt_on), options.scenario_state_size(a.scenario)
+        if have != need:
             raise UsageError(f"arm '{arm}': the policy {policy} was trained on road {learnt_on} "
-                             f"(state size {state_size(learnt_on)}), road {a.scenario} has "
-                             f"{state_size(a.scenario)}")
+                             f"(state size {have}), road {a.scenario} has {need}")
         seen = training_seeds(policy) & set(seeds)
         if seen:
             raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
