@@ -63,7 +63,8 @@ def lookup(metrics, key):
     return value
 
 
-def main(paths):
+def table(paths):
+    """The table of these metrics.json files, a column per run (its folder's name)."""
     runs = [(pathlib.Path(p).parent.name, json.loads(pathlib.Path(p).read_text())) for p in paths]
     # Rows no run has (e.g. decision latency of a SUMO-native run) are left out.
     rows = [r for r in ROWS if any(lookup(m, r[0]) is not None for _, m in runs)]
@@ -71,9 +72,14 @@ def main(paths):
     if not any(lookup(m, "v2x.enabled") for _, m in runs):
         rows = [r for r in rows if not r[0].startswith("v2x.")]
     width = max(14, *(len(n) for n, _ in runs))
-    print(f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs))
+    lines = [f"{'metric':34s}" + "".join(f"{n:>{width + 2}s}" for n, _ in runs)]
     for key, label, pattern in rows:
-        print(f"{label:34s}" + "".join(f"{fmt(lookup(m, key), pattern):>{width + 2}s}" for _, m in runs))
+        lines.append(f"{label:34s}" + "".join(f"{fmt(lookup(m, key), pattern):>{width + 2}s}" for _, m in runs))
+    return "\n".join(lines) + "\n"
+
+
+def main(paths):
+    sys.stdout.write(table(paths))
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tests of the arm registry (config/arms.json, tools/palcas_arms.py) and of adding an arm:
-one new entry in a scratch copy of the suite, and ./palcas's option checks, experiment.py,
-run_figures.py, train.py and launch/system.launch take it with no other edit. The launch part
+one new entry in a scratch copy of the suite, and ./palcas run / train / experiment
+(tools/palcas_cli), run_figures.py and launch/system.launch take it with no other edit. The launch part
 needs the workspace's ROS environment (./palcas test sources it).
 
 usage: arm_registry_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
@@ -156,7 +156,7 @@ class AddingAnArm(unittest.TestCase):
 
     def test_experiment_plans_its_points(self):
         out = self.copy / "experiment"
-        r = run([PYTHON, "tools/experiment.py", "plan", "--out", str(out), "--arms", f"keep,{NEW_ARM}",
+        r = run([PYTHON, "tools/palcas_cli", "experiment", "--plan", "--out", str(out), "--arms", f"keep,{NEW_ARM}",
                  "--prs", "60", "--seeds", "1", "--duration", "10", "--scenario", "tiny",
                  "--policy", f"{NEW_ARM}={self.policy}"], cwd=self.copy)
         self.assertEqual(r.returncode, 0, r.stderr)
@@ -169,14 +169,14 @@ class AddingAnArm(unittest.TestCase):
         self.assertEqual(r.stdout.strip(), f"['palcas', '{NEW_ARM}', 'keep'] Test arm", r.stderr)
 
     def test_train_takes_it_with_its_rsus(self):
-        r = run([PYTHON, "tools/train.py", "--root", str(self.copy), "--out", str(self.copy / "t"),
-                 "--arm", NEW_ARM, "--check-only"], cwd=self.copy)
+        r = run([PYTHON, "tools/palcas_cli", "check", "train", "--out", str(self.copy / "t"), "--arm", NEW_ARM],
+                cwd=self.copy)
         self.assertEqual(r.returncode, 0, r.stderr)
-        r = run([PYTHON, str(ROOT / "tools" / "train.py"), "--root", str(ROOT), "--out", str(self.copy / "t"),
-                 "--arm", NEW_ARM, "--check-only"], cwd=self.copy)
+        r = run([PYTHON, str(ROOT / "tools" / "palcas_cli"), "check", "train", "--out", str(self.copy / "t"),
+                 "--arm", NEW_ARM], cwd=self.copy)
         self.assertEqual(r.returncode, 2)
-        self.assertIn("not a learning arm", r.stderr)
-        r = run([PYTHON, "-c", f"import sys; sys.path.insert(0, 'tools'); import train; "
+        self.assertIn(f"--arm '{NEW_ARM}': unknown arm", r.stderr)
+        r = run([PYTHON, "-c", f"import sys; sys.path.insert(0, 'tools'); from palcas_cli import train; "
                  f"print(train.palcas_arms.rsu_ids('{NEW_ARM}', 3))"], cwd=self.copy)
         self.assertEqual(r.stdout.strip(), "['rsu_0', 'rsu_1', 'rsu_2']", r.stderr)
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of the experiment planner and collector (tools/experiment.py,
+"""Tests of the experiment planner and collector (tools/palcas_cli/experiment.py,
 tools/experiment_results.py), the interval arithmetic (tools/palcas_stats.py) and the
 figure functions (tools/run_figures.py), on fake run folders and a tiny recorded episode
 (fixtures/tiny_run: 60 s of the tiny road, keep and sumo_native, seed 101).
@@ -21,7 +21,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = pathlib.Path(__file__).resolve().parent / "fixtures" / "tiny_run"
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import experiment  # noqa: E402
+from palcas_cli import experiment  # noqa: E402
 import eval_table  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
@@ -32,7 +32,7 @@ from junit_runner import run_as_junit  # noqa: E402
 
 def args(**kw):
     base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
-                policy=None, jobs=1, check_only=False, demands=None, v2x="")
+                policy=None, jobs=1, demands=None, v2x="")
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -85,7 +85,7 @@ class PlannerTest(unittest.TestCase):
         self.assertEqual(experiment.write_plan(self.out, s), 8)
         lines = (self.out / "plan.txt").read_text().splitlines()
         self.assertEqual(len(lines), 8)
-        self.assertTrue(all("tools/experiment.py point" in line for line in lines))
+        self.assertTrue(all("./palcas experiment --point " in line for line in lines))
         self.assertIn("#SBATCH --array=1-8", (self.out / "slurm_array.sh").read_text())
 
     def test_bad_options_are_named(self):

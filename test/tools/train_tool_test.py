@@ -1,11 +1,9 @@
 #!/usr/bin/env python3
-"""Tests of tools/train.py (./palcas train's orchestration) without a simulation: the
-options a resumed training settles on, the training record, and how a console log is read
-(nodes that died for good, why a simulation ended early); and of tools/ship_policy.py.
+"""Tests of ./palcas train's orchestration (tools/palcas_cli/train.py) without a simulation:
+the options a resumed training settles on, the training record, the launch loop; and of
+tools/ship_policy.py. How a console log is read: test/tools/palcas_cli_test.py.
 
 usage: train_tool_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
-import contextlib
-import io
 import json
 import math
 import os
@@ -17,8 +15,9 @@ import unittest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from palcas_cli import launch, train  # noqa: E402
+from palcas_cli.options import OptionError  # noqa: E402
 import ship_policy  # noqa: E402
-import train  # noqa: E402
 import train_monitor  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -66,7 +65,7 @@ class SettleOptions(unittest.TestCase):
         self.assertEqual((opts["arm"], opts["pr"], opts["episodes"], opts["scenario"]), ("palcas", 20.0, 5, "paper"))
 
     def test_a_new_training_refuses_a_folder_that_holds_one(self):
-        with self.assertRaisesRegex(train.OptionError, "already holds a training"):
+        with self.assertRaisesRegex(OptionError, "already holds a training"):
             train.settle_options(given(), self.dir, resume=False)
 
     def test_resume_takes_everything_from_the_record(self):
@@ -86,15 +85,15 @@ class SettleOptions(unittest.TestCase):
                          (dict(scenario="paper"), "trained with --scenario tiny, not --scenario paper"),
                          (dict(seed=4), "trained with --seed 3, not --seed 4"),
                          (dict(explore_fraction=0.5), "leave --explore-fraction out")):
-            with self.assertRaisesRegex(train.OptionError, text):
+            with self.assertRaisesRegex(OptionError, text):
                 train.settle_options(given(**kw), self.dir, resume=True)
 
     def test_resume_needs_a_record(self):
-        with self.assertRaisesRegex(train.OptionError, "holds no training to resume"):
+        with self.assertRaisesRegex(OptionError, "holds no training to resume"):
             train.settle_options(given(), tempfile.mkdtemp(), resume=True)
         with open(os.path.join(self.dir, "train.json"), "w") as f:
             f.write('{"arm": "palcas"}')
-        with self.assertRaisesRegex(train.OptionError, "no field 'scenario'"):
+        with self.assertRaisesRegex(OptionError, "no field 'scenario'"):
             train.settle_options(given(), self.dir, resume=True)
 
 
@@ -124,11 +123,11 @@ class Record(unittest.TestCase):
 
     def test_message_key_is_made_once_and_owner_only(self):
         out = tempfile.mkdtemp()
-        key = train.message_key(out)
+        key = launch.message_key(out)
         first = open(key).read()
         self.assertEqual(len(first), 64)
         self.assertEqual(os.stat(key).st_mode & 0o777, 0o600)
-        self.assertEqual(open(train.message_key(out)).read(), first)
+        self.assertEqual(open(launch.message_key(out)).read(), first)
 
 
 class DemandAndRanges(unittest.TestCase):
@@ -185,9 +184,9 @@ class DemandAndRanges(unittest.TestCase):
                            pr_range=None), f)
         opts, _ = train.settle_options(given(), out, resume=True)
         self.assertEqual((opts["demand_range"], opts["demand"]), ([1000, 2000], None))
-        with self.assertRaisesRegex(train.OptionError, "trained with --demand-range 1000,2000, not --demand-range 1000,2200"):
+        with self.assertRaisesRegex(OptionError, "trained with --demand-range 1000,2000, not --demand-range 1000,2200"):
             train.settle_options(given(demand_range=[1000, 2200]), out, resume=True)
-        with self.assertRaisesRegex(train.OptionError, r"trained with --demand \(the scenario's\), not --demand 1400"):
+        with self.assertRaisesRegex(OptionError, r"trained with --demand \(the scenario's\), not --demand 1400"):
             train.settle_options(given(demand=1400.0), out, resume=True)
         # A record from before demand was an option: the scenario's demand, no ranges.
         opts, _ = train.settle_options(given(), self.old_record(), resume=True)
@@ -202,14 +201,11 @@ class DemandAndRanges(unittest.TestCase):
     def test_bad_ranges_are_refused_naming_the_option(self):
         for argv, text in ((["--demand-range", "2000,1000"], "--demand-range '2000,1000': MIN 2000 is greater than MAX 1000"),
                            (["--demand-range", "1000"], "--demand-range '1000': expected MIN,MAX"),
-                           (["--pr-range", "10,200"], r"--pr-range '10,200': expected MIN,MAX, two numbers in \[0, 100\]"),
+                           (["--pr-range", "10,200"], r"--pr-range '10,200': MAX '200': expected a number in \[0, 100\]"),
                            (["--demand", "1000", "--demand-range", "1000,2000"], "--demand and --demand-range"),
                            (["--pr", "40", "--pr-range", "10,20"], "--pr and --pr-range")):
-            err = io.StringIO()
-            with contextlib.redirect_stderr(err):
-                status = train.main(["--root", str(ROOT), "--check-only"] + argv)
-            self.assertEqual(status, 2, argv)
-            self.assertRegex(err.getvalue(), text)
+            with self.subTest(argv=argv), self.assertRaisesRegex(OptionError, text):
+                train.check(argv)
 
     def launches(self, opts):
         """run_launches with a stand-in roslaunch that finishes the episodes it is given:
@@ -232,7 +228,7 @@ class DemandAndRanges(unittest.TestCase):
                         f.write("episode\n" if fresh else "")
                         f.write("x\n" * n)
 
-            def wait(self):
+            def wait(self, timeout=None):
                 return 0
 
             def poll(self):
@@ -241,14 +237,10 @@ class DemandAndRanges(unittest.TestCase):
             def terminate(self):
                 pass
 
-        class Args:
-            resume = False
-            command_line = "test"
-
         real = train.subprocess.Popen
         train.subprocess.Popen = FakeProcess
         try:
-            status = train.run_launches(str(ROOT), out, opts, {"git_commit": "x"}, Args(), train.Interrupt())
+            status = train.run_launches(out, opts, {"git_commit": "x"}, False, "test")
         finally:
             train.subprocess.Popen = real
         self.assertEqual(status, 0)
@@ -279,33 +271,10 @@ class DemandAndRanges(unittest.TestCase):
         self.assertEqual(calls[0]["demand"], "scenario")
 
 
-class ConsoleLog(unittest.TestCase):
-    def test_a_node_that_died_and_came_back_is_not_lost(self):
-        text = ("[rsu_0/rsu-4] process has died [pid 1, exit code -9, cmd x]\n"
-                "[rsu_0/rsu-4] restarting process\n")
-        self.assertEqual(train.node_deaths(text), [])
-
-    def test_a_death_without_restart_or_a_crash_loop_is_lost(self):
-        text = "\x1b[31m[rsu_1/rsu-5] process has died [pid 2, exit code 1, cmd x]\x1b[0m\n"
-        loop = "".join("[fedserver-3] process has died [pid %d, exit code -6, cmd x]\n"
-                       "[fedserver-3] restarting process\n" % k for k in range(3))
-        self.assertEqual(train.node_deaths(text + loop),
-                         ["fedserver-3 (exit code -6, died 3 times)", "rsu_1/rsu-5 (exit code 1)"])
-
-    def test_a_clean_exit_is_not_a_death(self):
-        self.assertEqual(train.node_deaths("[rsu_0/rsu-4] process has died [pid 1, exit code 0, cmd x]\n"), [])
-
-    def test_the_simulations_own_error_is_the_crash_reason(self):
-        text = ("[rsu_0/rsu-4] process has died [pid 1, exit code -15, cmd x]\n"
-                "sumo: MSVehicle.cpp:123: Assertion `myFurtherLanes.size() > 0' failed.\n")
-        self.assertIn("myFurtherLanes", train.crash_reason(text))
-        self.assertIn("process has died", train.crash_reason("[x] process has died [pid 1, exit code 1]"))
-        self.assertEqual(train.crash_reason("all fine"), "")
-        self.assertIn("[FATAL]", train.last_fatal("[ INFO] ok\n[FATAL] [1.0]: bad key\n"))
-
+class Roads(unittest.TestCase):
     def test_clusters_come_from_the_roads_description(self):
-        self.assertEqual(train.scenario_clusters(str(ROOT), "paper"), 3)
-        self.assertEqual(train.scenario_clusters(str(ROOT), "tiny"), 2)
+        self.assertEqual(train.scenario_clusters("paper"), 3)
+        self.assertEqual(train.scenario_clusters("tiny"), 2)
 
 
 class ScenarioFiles(unittest.TestCase):
@@ -328,7 +297,7 @@ class ScenarioFiles(unittest.TestCase):
                 continue
             road = yaml.safe_load((folder / "scenario.yaml").read_text())["road"]
             self.assertEqual(self.launch_rsu_count(str(folder)), road["clusters"], folder.name)
-            self.assertEqual(train.scenario_clusters(str(ROOT), folder.name), road["clusters"], folder.name)
+            self.assertEqual(train.scenario_clusters(folder.name), road["clusters"], folder.name)
             for gone in ("rsus.yaml", "learning.yaml", "network.nod.xml"):
                 self.assertFalse((folder / gone).exists(), "%s/%s: the road is generated" % (folder.name, gone))
 

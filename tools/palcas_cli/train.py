@@ -1,16 +1,8 @@
-#!/usr/bin/env python3
-"""Training orchestration behind `./palcas train`: the training record, resume, the launch
-loop that survives SUMO's own crashes, progress and learning curves.
+"""./palcas train: the training record, resume, the launch loop that survives SUMO's own
+crashes, progress and learning curves.
 
-`./palcas` checks every option's value and builds the workspace, then runs this tool with
-the checked values; options the user did not give are absent. What is left to check here
-(a resumed training's record) is checked before any folder is made or process started.
-
-usage: train.py --root REPO --out DIR [--resume] [--arm A] [--episodes N] [--duration S]
-                [--pr P | --pr-range MIN,MAX] [--demand VPHPL | --demand-range MIN,MAX]
-                [--ramp-demand VPH] [--seed N] [--scenario NAME] [--explore-fraction F]
-                [--learning FILE] [--rsu-params FILE] [--bridge-params FILE] [--v2x FILE]
-                [--paper-printed] --command-line TEXT [--check-only]
+check(argv) reads and checks the options (OptionError: exit 2, nothing made or started), a
+resumed training's record included; main(argv) then trains in the built, sourced workspace.
 
 Demand: --demand sets the mainline demand [veh/h per lane] and --ramp-demand the on-ramp
 demand [veh/h per ramp] of every episode (the launch's demand / ramp_demand; absent = the
@@ -27,20 +19,18 @@ episodes share one launch, as before. The ranges and every episode's draw are in
 
 Exit status: 0 done; 1 a node died for good or nothing was trained; 2 a bad option;
 130 / 143 interrupted (SIGINT / SIGTERM: every process stopped and checkpointed)."""
-import argparse
 import datetime
 import json
 import os
 import random
 import re
-import signal
-import socket
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import palcas_arms  # noqa: E402
-import policy_folder  # noqa: E402
+from palcas_cli import Console, launch, options
+from palcas_cli.options import OptionError
+import palcas_arms
+import policy_folder
 
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
@@ -53,16 +43,19 @@ RESUMED_DEMAND = {"demand": "demand_vphpl", "ramp_demand": "ramp_demand_vph",
                   "demand_range": "demand_range", "pr_range": "pr_range"}
 ALL_GIVEN = ("arm", "episodes", "duration", "pr", "seed", "scenario", "explore_fraction", "demand",
              "ramp_demand", "demand_range", "pr_range")
-ANSI = re.compile(r"\x1b\[[0-9;]*m")
-MAX_DEMAND = 100000  # veh/h per lane: what the bridge accepts
 
 
-class OptionError(Exception):
-    """A bad command line (exit 2, nothing started)."""
+VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "--duration": "duration",
+          "--pr": "pr", "--pr-range": "pr_range", "--demand": "demand", "--demand-range": "demand_range",
+          "--ramp-demand": "ramp_demand", "--seed": "seed", "--arm": "arm", "--out": "out", "--scenario": "scenario",
+          "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
+          "--v2x": "v2x_params"}
+FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True)}
+console = Console()
 
 
 def log(text):
-    print("[palcas] %s" % text, file=sys.stderr, flush=True)
+    console.log(text)
 
 
 def number_text(value):
@@ -89,21 +82,6 @@ def value_text(value):
     if isinstance(value, (list, tuple)):
         return ",".join(number_text(v) for v in value)
     return number_text(value)
-
-
-def parse_range(text, option, low, high):
-    """'MIN,MAX' -> [MIN, MAX] within [low, high], MIN <= MAX. Raises OptionError naming the option."""
-    parts = text.split(",")
-    try:
-        lo, hi = (float(p) for p in parts) if len(parts) == 2 else (None, None)
-    except ValueError:
-        lo = hi = None
-    if lo is None or not (low <= lo <= high and low <= hi <= high):
-        raise OptionError("%s '%s': expected MIN,MAX, two numbers in [%s, %s]"
-                          % (option, text, number_text(low), number_text(high)))
-    if lo > hi:
-        raise OptionError("%s '%s': MIN %s is greater than MAX %s" % (option, text, number_text(lo), number_text(hi)))
-    return [as_number(lo), as_number(hi)]
 
 
 def episode_draw(opts, episode):
@@ -226,104 +204,13 @@ def episodes_done(out):
         return 0
 
 
-def node_deaths(console_text):
-    """Nodes of a roslaunch console that died for good: a non-zero exit not followed by a
-    restart (respawn), or three deaths (a crash loop). 'name (exit code N[, died k times])'."""
-    text = ANSI.sub("", console_text)
-    deaths, restarts, codes = {}, {}, {}
-    for m in re.finditer(r"\[([^\[\]\s]+)\] process has died \[pid \d+, exit code (-?\d+)", text):
-        if m.group(2) != "0":
-            deaths[m.group(1)] = deaths.get(m.group(1), 0) + 1
-            codes[m.group(1)] = m.group(2)
-    for m in re.finditer(r"\[([^\[\]\s]+)\] restarting process", text):
-        restarts[m.group(1)] = restarts.get(m.group(1), 0) + 1
-    lost = []
-    for node in sorted(deaths):
-        d, r = deaths[node], restarts.get(node, 0)
-        if d > r or d >= 3:
-            lost.append("%s (exit code %s%s)" % (node, codes[node], ", died %d times" % d if d > 1 else ""))
-    return lost
-
-
-def last_fatal(console_text):
-    """The last FATAL/ERROR line or SUMO assertion, shortened."""
-    lines = [l for l in ANSI.sub("", console_text).splitlines()
-             if re.search(r"\[(FATAL|ERROR)\]|Assertion .* failed|Segmentation fault", l)]
-    return lines[-1][:400] if lines else ""
-
-
-def crash_reason(console_text):
-    """Why the simulation ended early: its own error first (an RSU killed on the way is not why)."""
-    text = ANSI.sub("", console_text)
-    found = re.findall(r"(?:Assertion.*|Segmentation fault.*|\[FATAL\].*)", text)
-    if found:
-        return found[-1][:200]
-    died = re.search(r"process has died.*", text)
-    return died.group(0)[:200] if died else ""
-
-
-def read_text(path):
-    try:
-        with open(path, errors="replace") as f:
-            return f.read()
-    except OSError:
-        return ""
-
-
-def message_key(out):
-    """<out>/auth.key: the training's random message key (hex, owner-only), made on first use."""
-    key = os.path.join(out, "auth.key")
-    if not (os.path.isfile(key) and os.path.getsize(key) > 0):
-        tmp = key + ".tmp"
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        with os.fdopen(fd, "w") as f:
-            f.write(os.urandom(32).hex())
-        os.replace(tmp, key)
-    return key
-
-
-def free_port():
-    s = socket.socket()
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
-
-
-def scenario_clusters(root, scenario):
-    """road/clusters of config/scenarios/<name>/scenario.yaml (the launch files read the same line)."""
-    text = read_text(os.path.join(root, "config", "scenarios", scenario, "scenario.yaml"))
+def scenario_clusters(scenario):
+    """road/clusters of the road's scenario.yaml (the launch files read the same line)."""
+    text = launch.read_text(options.scenario_yaml(scenario))
     m = re.search(r"^\s*clusters:\s*(\d+)", text, re.M)
     if not m:
         raise OptionError("--scenario %s: its scenario.yaml has no road/clusters" % scenario)
     return int(m.group(1))
-
-
-def git_commit(root):
-    try:
-        return subprocess.run(["git", "-C", root, "rev-parse", "HEAD"], capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
-
-
-class Interrupt:
-    """SIGINT (Ctrl-C reaches roslaunch too: same process group) or SIGTERM (passed on to
-    roslaunch as SIGINT): remembered, and the launch is waited for while it shuts down."""
-
-    def __init__(self):
-        self.signal = None
-        self.launch = None
-        signal.signal(signal.SIGINT, self._on_int)
-        signal.signal(signal.SIGTERM, self._on_term)
-
-    def _on_int(self, *_):
-        self.signal = "INT"
-
-    def _on_term(self, *_):
-        self.signal = "TERM"
-        if self.launch and self.launch.poll() is None:
-            self.launch.send_signal(signal.SIGINT)
 
 
 def keep_episode_metrics(out, episode):
@@ -343,13 +230,14 @@ def keep_episode_metrics(out, episode):
         f.write(text)
 
 
-def run_launches(root, out, opts, record, args, interrupt):
+def run_launches(out, opts, record, resume, command_line):
     """The launch loop: one roslaunch for the episodes left (one per episode when demand or
     PR is drawn per episode); a simulation that died ends that episode only (the nodes
-    checkpointed) and the next launch goes on with the next episode. Returns the exit status."""
+    checkpointed) and the next launch goes on with the next episode. Returns the exit status;
+    raises launch.Interrupted (every node stopped and checkpointed)."""
     episodes, seed = int(opts["episodes"]), int(opts["seed"])
-    clusters = scenario_clusters(root, opts["scenario"])
-    auth_key = message_key(out)
+    clusters = scenario_clusters(opts["scenario"])
+    auth_key = launch.message_key(out)
     done = episodes_done(out)
     log("training %s: episodes %d..%d x %ss, pr=%s%% demand=%s seed=%d -> %s"
         % (opts["arm"], done + 1, episodes, number_text(opts["duration"]),
@@ -358,13 +246,10 @@ def run_launches(root, out, opts, record, args, interrupt):
            + (" veh/h/lane" if opts["demand_range"] or opts["demand"] is not None else "")
            + (" (drawn per episode)" if opts["demand_range"] else ""), seed, out))
     nxt, launches, status = done, 0, 0
-    env = dict(os.environ, ROS_HOSTNAME="127.0.0.1", ROS_LOG_DIR=os.path.join(out, "ros_log"))
     while nxt < episodes and launches < episodes + 3 + episodes // 4:
         launches += 1
         rows_before = episodes_done(out)
-        port = free_port()
-        env["ROS_MASTER_URI"] = "http://127.0.0.1:%d" % port
-        resume_nodes = "true" if (nxt > 0 or args.resume) else "false"
+        resume_nodes = "true" if (nxt > 0 or resume) else "false"
         draw = episode_draw(opts, nxt)
         count = 1 if sampled(opts) else episodes - nxt
         if sampled(opts):
@@ -381,39 +266,28 @@ def run_launches(root, out, opts, record, args, interrupt):
             "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
             "v2x_params:=%s" % (opts.get("v2x_params") or "none"),
             "paper_printed:=%s" % str(bool(opts.get("paper_printed"))).lower(), "auth_key_file:=%s" % auth_key,
-            "git_commit:=%s" % record["git_commit"], "command_line:=%s" % args.command_line]
-        with open(os.path.join(out, "console.log"), "a") as console:
-            # --pdeathsig: if this process is killed outright (SIGKILL, no handler runs),
-            # roslaunch still gets SIGINT and shuts its nodes down cleanly (they checkpoint).
-            interrupt.launch = subprocess.Popen(
-                ["setpriv", "--pdeathsig", "INT", "roslaunch", "-p", str(port), "palcas_launch", "system.launch"]
-                + launch_args, stdout=console, stderr=subprocess.STDOUT, env=env)
-            monitor = subprocess.Popen(
-                ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(root, "tools", "train_monitor.py"),
-                 "--rsus"] + palcas_arms.rsu_ids(opts["arm"], clusters)
-                + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
-                   "--duration", number_text(opts["duration"]), "--period", "15"],
-                stderr=subprocess.DEVNULL, env=env)
-            while True:
-                try:
-                    status = interrupt.launch.wait()
-                    break
-                except InterruptedError:
-                    continue
+            "git_commit:=%s" % record["git_commit"], "command_line:=%s" % command_line]
+        train_launch = launch.Launch(["palcas_launch", "system.launch"] + launch_args, os.path.join(out, "console.log"),
+                                     os.path.join(out, "ros_log"), append=True).start()
+        monitor = subprocess.Popen(
+            ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(str(options.ROOT), "tools", "train_monitor.py"),
+             "--rsus"] + palcas_arms.rsu_ids(opts["arm"], clusters)
+            + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
+               "--duration", number_text(opts["duration"]), "--period", "15"],
+            stderr=subprocess.DEVNULL, env=launch.ros_env(train_launch.port, os.path.join(out, "ros_log")))
+        try:
+            status = train_launch.wait()
+        finally:
             monitor.terminate()
             monitor.wait()
-        if interrupt.signal:
-            log("interrupted (%s): every node stopped and checkpointed; continue with "
-                "./palcas train --resume --out %s" % (interrupt.signal, out))
-            return 130 if interrupt.signal == "INT" else 143
         rows_after = episodes_done(out)
-        console_text = read_text(os.path.join(out, "console.log"))
+        console_text = launch.read_text(os.path.join(out, "console.log"))
         # An RSU or the server that died leaves episodes trained without it: not a training
         # of this arm. Say which node and why, and stop (the simulation's crashes are below).
-        lost = [d for d in node_deaths(console_text) if not d.startswith("palcas_sumo_bridge")]
+        lost = [d for d in launch.node_deaths(console_text) if not d.startswith("palcas_sumo_bridge")]
         if lost:
-            print("[palcas] error: training lost node(s) %s; last error: %s"
-                  % (", ".join(lost), last_fatal(console_text)), file=sys.stderr, flush=True)
+            console.error("training lost node(s) %s; last error: %s"
+                          % (", ".join(lost), launch.last_fatal(console_text)))
             with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
                 f.write("launch %d: lost %s; episodes.csv rows %d..%d were run without it\n"
                         % (launches, ", ".join(lost), rows_before + 1, rows_after))
@@ -428,7 +302,7 @@ def run_launches(root, out, opts, record, args, interrupt):
         if short:
             # The simulation died (SUMO assertion, signal, or a fatal error of the bridge):
             # that episode only is lost; the training goes on with the next one (its own seed).
-            why = crash_reason(console_text)
+            why = launch.crash_reason(console_text)
             log("episode %d ended early (%s); resuming from the checkpoints with the next episode"
                 % (nxt + 1, why or "no reason in the log"))
             with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
@@ -438,87 +312,83 @@ def run_launches(root, out, opts, record, args, interrupt):
     return 0 if status in (0, None) else status
 
 
-def parse(argv):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--root", required=True, help="the repository")
-    ap.add_argument("--out", default="")
-    ap.add_argument("--results-dir", default="", help="where a training without --out goes")
-    ap.add_argument("--resume", action="store_true")
-    ap.add_argument("--arm")
-    ap.add_argument("--episodes", type=int)
-    ap.add_argument("--duration", type=float)
-    ap.add_argument("--pr", type=float)
-    ap.add_argument("--pr-range", help="MIN,MAX [%%]: each episode draws its PR from it")
-    ap.add_argument("--demand", type=float, help="mainline demand [veh/h per lane]")
-    ap.add_argument("--ramp-demand", type=float, help="on-ramp demand [veh/h per ramp]")
-    ap.add_argument("--demand-range", help="MIN,MAX [veh/h per lane]: each episode draws its demand from it")
-    ap.add_argument("--seed", type=int)
-    ap.add_argument("--scenario")
-    ap.add_argument("--explore-fraction", type=float)
-    ap.add_argument("--learning", default="")
-    ap.add_argument("--rsu-params", default="")
-    ap.add_argument("--bridge-params", default="")
-    ap.add_argument("--v2x", default="", help="a YAML over config/v2x.yaml: train with the V2X channel on")
-    ap.add_argument("--paper-printed", action="store_true")
-    ap.add_argument("--command-line", default="./palcas train")
-    ap.add_argument("--check-only", action="store_true", help="check the options against the record, start nothing")
-    return ap.parse_args(argv)
+def check(argv):
+    """The training's options from its command line: (opts, record, out, resume); a resumed
+    training takes what was not given from its record (record: None for a new one). Raises
+    OptionError naming a bad option, before anything is made or started."""
+    given = options.parse("train", argv, VALUES, FLAGS)
+    value = dict({"episodes": "5", "duration": "3600", "pr": "60", "seed": "1", "explore_fraction": "0.5",
+                  "arm": "palcas", "scenario": "paper"}, **given)
+    settled = {"episodes": options.integer_in("--episodes", value["episodes"], 1),
+               "duration": float(options.number_in("--duration", value["duration"], 0, None, open_low=True)),
+               "pr": float(options.number_in("--pr", value["pr"], 0, 100)),
+               "seed": options.integer_in("--seed", value["seed"], 0, options.MAX_SEED),
+               "explore_fraction": float(options.number_in("--explore-fraction", value["explore_fraction"], 0, 1,
+                                                           open_low=True))}
+    for key, option in (("demand", "--demand"), ("ramp_demand", "--ramp-demand")):
+        if given.get(key):
+            settled[key] = float(options.number_in(option, given[key], 0, options.MAX_DEMAND))
+    for key, option, high in (("demand_range", "--demand-range", options.MAX_DEMAND), ("pr_range", "--pr-range", 100)):
+        if given.get(key):
+            settled[key] = [as_number(float(v)) for v in options.range_in(option, given[key], 0, high).split(",")]
+    if settled.get("demand") is not None and settled.get("demand_range"):
+        raise OptionError("--demand and --demand-range: give one of them")
+    if "pr" in given and settled.get("pr_range"):
+        raise OptionError("--pr and --pr-range: give one of them")
+    settled["scenario"] = options.scenario_ok("--scenario", value["scenario"])
+    settled["arm"] = options.known_arm(value["arm"], palcas_arms.LEARNING_ARMS)
+    if not palcas_arms.is_learning(settled["arm"]):
+        raise OptionError("--arm %s: evaluation only, it learns nothing (run it with ./palcas run --arm %s)"
+                          % (settled["arm"], settled["arm"]))
+    overrides = {key: options.file_ok("--" + option, given[key]) if given.get(key) else ""
+                 for key, option in (("learning", "learning"), ("rsu_params", "rsu-params"),
+                                     ("bridge_params", "bridge-params"), ("v2x_params", "v2x"))}
+    out = options.out_ok(given.get("out", ""))
+    resume = bool(given.get("resume"))
+    # What the user set (the rest is a default, or a resumed training's record).
+    chosen = {k: settled.get(k) if k in given else None for k in ALL_GIVEN}
+    opts, record = settle_options(chosen, out, resume)
+    if not resume:
+        opts.update(overrides, paper_printed=bool(given.get("paper_printed")))
+    return opts, record, out, resume
 
 
-def main(argv=None):
-    args = parse(sys.argv[1:] if argv is None else argv)
-    given = {k: getattr(args, k) for k in ALL_GIVEN}
-    try:
-        if given["arm"] is not None and not palcas_arms.is_learning(given["arm"]):
-            raise OptionError("--arm '%s': not a learning arm (%s)" % (given["arm"], ", ".join(palcas_arms.LEARNING_ARMS)))
-        for option, low, high in (("demand_range", 0, MAX_DEMAND), ("pr_range", 0, 100)):
-            if given[option] is not None:
-                given[option] = parse_range(given[option], "--" + option.replace("_", "-"), low, high)
-        if given["demand"] is not None and given["demand_range"] is not None:
-            raise OptionError("--demand and --demand-range: give one of them")
-        if given["pr"] is not None and given["pr_range"] is not None:
-            raise OptionError("--pr and --pr-range: give one of them")
-        opts, record = settle_options(given, args.out, args.resume)
-    except OptionError as e:
-        print("[palcas] error: %s" % e, file=sys.stderr)
-        return 2
-    if args.check_only:
-        return 0
-    if not args.resume:
-        opts.update(learning=args.learning, rsu_params=args.rsu_params, bridge_params=args.bridge_params,
-                    v2x_params=args.v2x,
-                    paper_printed=args.paper_printed)
-    out = args.out or os.path.join(args.results_dir or os.path.join(args.root, "results"), "train-%s-%s" % (
+def main(argv):
+    opts, _, out, resume = check(argv)
+    launch.handle_signals()
+    out = out or os.path.join(options.results_dir(), "train-%s-%s" % (
         opts["arm"], datetime.datetime.now().strftime("%Y%m%d-%H%M%S")))
     os.makedirs(policy_folder.checkpoints(out), exist_ok=True)
     out = os.path.abspath(out)
-    if args.resume and episodes_done(out) >= int(opts["episodes"]):
+    if resume and episodes_done(out) >= int(opts["episodes"]):
         log("all %d episodes done in %s" % (int(opts["episodes"]), out))
         return 0
-    if not args.resume:
+    if not resume:
         # The exploration schedule is a share of this training's budget, not of a 72-hour run.
         schedule = os.path.join(out, "learning_schedule.yaml")
-        cmd = [sys.executable, os.path.join(args.root, "tools", "train_schedule.py"), schedule,
-               "--episodes", str(opts["episodes"]), "--duration", number_text(opts["duration"]),
-               "--fraction", number_text(opts["explore_fraction"])]
-        if opts["learning"]:
-            cmd += ["--base", opts["learning"]]
-        if subprocess.run(cmd).returncode != 0:
-            print("[palcas] error: bad --explore-fraction", file=sys.stderr)
+        try:
+            import train_schedule  # PyYAML: installed by then
+            train_schedule.write(schedule, opts["episodes"], opts["duration"], opts["explore_fraction"],
+                                 base=opts["learning"])
+        except Exception as e:  # noqa: BLE001 - a bad base file, named with its fault
+            console.error(str(e))
             return 1
         opts["learning"] = schedule
-    record = write_record(out, opts, git_commit(args.root), args.command_line, bool(args.resume))
-    interrupt = Interrupt()
-    status = run_launches(args.root, out, opts, record, args, interrupt)
-    if status in (130, 143):
-        return status
+    command_line = "./palcas train " + " ".join(argv)
+    record = write_record(out, opts, launch.git_commit(), command_line, resume)
+    try:
+        status = run_launches(out, opts, record, resume, command_line)
+    except launch.Interrupted as stop:
+        log("interrupted (%s): every node stopped and checkpointed; continue with "
+            "./palcas train --resume --out %s" % (stop.signal, out))
+        return stop.status
     if not os.path.isfile(os.path.join(out, "episodes.csv")):
-        print("[palcas] error: training wrote no episodes.csv (see %s/console.log)" % out, file=sys.stderr)
+        console.error("training wrote no episodes.csv (see %s/console.log)" % out)
         return 1
-    subprocess.run([sys.executable, os.path.join(args.root, "tools", "learning_curves.py"), out])
+    try:
+        import learning_curves  # matplotlib: only once there is something to draw
+        learning_curves.main(out)
+    except Exception as e:  # noqa: BLE001 - the training stands without its curves
+        log("warning: no learning curves (%s)" % e)
     log("training folder: %s (evaluate with: ./palcas run --policy %s)" % (out, out))
     return status
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,20 +1,21 @@
-#!/usr/bin/env python3
-"""The paper's experiment: arms x PRs x evaluation seeds, each point an independent run.
+"""./palcas experiment: the paper's experiment, arms x PRs x evaluation seeds, each point an
+independent run of ./palcas run's code (palcas_cli.run), several at a time in threads.
 
-  experiment.py run     --out DIR [--arms a,b] [--prs 5,10] [--demands 1000,1400] [--seeds N]
-                        [--duration S] [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
-  experiment.py plan    (same options): write DIR/plan.txt (one command per point) and
-                        DIR/slurm_array.sh, run nothing
-  experiment.py point   --out DIR --name POINT   run one planned point (what plan.txt calls)
-  experiment.py collect --out DIR   results.csv, tables and figures from the point folders
+  ./palcas experiment --out DIR [--arms a,b] [--prs 5,10] [--demands 1000,1400] [--seeds N]
+                      [--duration S] [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
+  ./palcas experiment --plan (same options): write DIR/plan.txt (one command per point) and
+                      DIR/slurm_array.sh, run nothing
+  ./palcas experiment --point NAME --out DIR   run one planned point (what plan.txt calls)
+  ./palcas experiment --collect --out DIR      results.csv, tables and figures from the point folders
 
 Layout: DIR/experiment.json (the settings; a later call must agree with them), and per point
 DIR/points/<arm>_pr<P>_s<seed>/ (with --demands: <arm>_pr<P>_d<D>_s<seed>/) with
-<arm>/metrics.json, manifest.json, console.log and point.json (status, exit code, wall time,
-command). --demands (mainline veh/h per lane) is a dimension beside arms, PRs and seeds;
-without it every point runs at the scenario's own demand, as experiments did before it. A point is finished when its
+<arm>/metrics.json, manifest.json, console.log, point.log (what the run said) and point.json
+(status, exit code, wall time, the equivalent ./palcas run command). --demands (mainline
+veh/h per lane) is a dimension beside arms, PRs and seeds; without it every point runs at the
+scenario's own demand, as experiments did before it. A point is finished when its
 metrics.json covers the whole duration; finished points are never run again, so an
-interrupted experiment continues where it stopped. Called by `./palcas experiment`.
+interrupted experiment continues where it stopped.
 """
 import argparse
 import concurrent.futures
@@ -24,26 +25,26 @@ import pathlib
 import re
 import shlex
 import signal
-import subprocess
 import sys
 import threading
 import time
+import traceback
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tools"))
-import experiment_results  # noqa: E402
-import policy_folder  # noqa: E402
-from palcas_arms import ALL_ARMS, LEARNING_ARMS  # noqa: E402
+from palcas_cli import Console, ROOT, launch, options, run
+from palcas_cli.options import OptionError
+import experiment_results
+import policy_folder
+from palcas_arms import ALL_ARMS, LEARNING_ARMS
 
 PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.
 FIXED_KEYS = ("duration_s", "scenario", "v2x")
-MAX_DEMAND = 100000.0  # veh/h per lane: what the bridge accepts
 
 
-class UsageError(Exception):
-    pass
+class UsageError(OptionError):
+    """A bad command line of the experiment (exit 2, nothing written)."""
+    prefix = "[experiment]"
 
 
 def parse_list(text, what, convert):
@@ -74,13 +75,6 @@ def training_seeds(policy_dir):
     return set(range(int(t["seed"]), int(t["seed"]) + int(t["episodes"])))
 
 
-def state_size(scenario):
-    """40 + the road's lane count (road/num_lanes of the scenario's scenario.yaml)."""
-    import yaml
-    f = ROOT / "config" / "scenarios" / scenario / "scenario.yaml"
-    return 40 + int(yaml.safe_load(f.read_text())["road"]["num_lanes"])
-
-
 def settings_from_args(a):
     arms = parse_list(a.arms, "arms", str)
     for arm in arms:
@@ -94,13 +88,13 @@ def settings_from_args(a):
     if a.demands is not None:
         demands = parse_list(a.demands, "demands", float)
         for d in demands:
-            if not 0.0 < d <= MAX_DEMAND:
-                raise UsageError(f"--demands: {d:g} is outside (0, {MAX_DEMAND:g}] veh/h per lane")
+            if not 0.0 < d <= options.MAX_DEMAND:
+                raise UsageError(f"--demands: {d:g} is outside (0, {options.MAX_DEMAND:g}] veh/h per lane")
     if a.seeds < 1:
         raise UsageError(f"--seeds: {a.seeds} must be >= 1")
     if not a.duration > 0:
         raise UsageError(f"--duration: {a.duration} must be > 0")
-    if not (ROOT / "config" / "scenarios" / a.scenario / "scenario.yaml").exists():
+    if not (options.SCENARIOS / a.scenario / "scenario.yaml").exists():
         raise UsageError(f"--scenario: no road '{a.scenario}' under config/scenarios")
     policies = {}
     for item in a.policy or []:
@@ -117,10 +111,10 @@ def settings_from_args(a):
             raise UsageError(f"arm '{arm}': no trained policy at {policy} (train it with "
                              f"./palcas train --arm {arm}, or pass --policy {arm}=DIR)")
         learnt_on = policy_folder.train_record(policy)["scenario"]
-        if state_size(learnt_on) != state_size(a.scenario):
+        have, need = options.scenario_state_size(learnt_on), options.scenario_state_size(a.scenario)
+        if have != need:
             raise UsageError(f"arm '{arm}': the policy {policy} was trained on road {learnt_on} "
-                             f"(state size {state_size(learnt_on)}), road {a.scenario} has "
-                             f"{state_size(a.scenario)}")
+                             f"(state size {have}), road {a.scenario} has {need}")
         seen = training_seeds(policy) & set(seeds)
         if seen:
             raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
@@ -182,8 +176,9 @@ def points_of(settings):
 
 
 def point_command(out, name):
-    return (f"cd {shlex.quote(str(ROOT))} && /usr/bin/python3 tools/experiment.py point "
-            f"--out {shlex.quote(str(out))} --name {shlex.quote(name)}")
+    # PALCAS_NO_BUILD: the repository is built once, not by every point of an array.
+    return (f"cd {shlex.quote(str(ROOT))} && PALCAS_NO_BUILD=1 ./palcas experiment --point {shlex.quote(name)} "
+            f"--out {shlex.quote(str(out))}")
 
 
 def point_dir(out, p):
@@ -230,33 +225,9 @@ def last_error(point_log, console):
     return (own[-1] if own else "no output")[:300]
 
 
-_children = set()
-_children_lock = threading.Lock()
-
-
-def stop_children(grace_s=30.0):
-    """SIGINT to every running point's process group (roslaunch shuts its nodes down), then
-    SIGKILL what is left after grace_s: an interrupted experiment leaves no process behind."""
-    with _children_lock:
-        procs = list(_children)
-    for proc in procs:
-        try:
-            os.killpg(proc.pid, signal.SIGINT)
-        except ProcessLookupError:
-            pass
-    deadline = time.time() + grace_s
-    for proc in procs:
-        try:
-            proc.wait(timeout=max(0.1, deadline - time.time()))
-        except subprocess.TimeoutExpired:
-            try:
-                os.killpg(proc.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-
-
 def run_point(out, name):
-    """Runs one point through ./palcas run and writes its point.json; returns the exit code."""
+    """Runs one point with ./palcas run's code, its output in the point's point.log, and writes
+    its point.json; returns the exit code (130 / 143 if the experiment was interrupted)."""
     settings = json.loads((out / "experiment.json").read_text())
     pts = {p["name"]: p for p in points_of(settings)}
     if name not in pts:
@@ -264,41 +235,38 @@ def run_point(out, name):
     p = pts[name]
     d = point_dir(out, p)
     d.mkdir(parents=True, exist_ok=True)
-    cmd = [str(ROOT / "palcas"), "run", "--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}",
-           "--seed", str(p["seed"]), "--duration", f"{settings['duration_s']:g}",
-           "--scenario", settings["scenario"], "--out", str(d)]
+    argv = ["--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}", "--seed", str(p["seed"]),
+            "--duration", f"{settings['duration_s']:g}", "--scenario", settings["scenario"], "--out", str(d)]
     if p["demand"] is not None:
-        cmd += ["--demand", f"{p['demand']:g}"]
+        argv += ["--demand", f"{p['demand']:g}"]
     if p["arm"] in settings["policies"]:
-        cmd += ["--policy", settings["policies"][p["arm"]]]
+        argv += ["--policy", settings["policies"][p["arm"]]]
     if not p["trajectories"]:
-        cmd += ["--no-trajectories"]
+        argv += ["--no-trajectories"]
     if settings.get("v2x"):
-        cmd += ["--v2x", settings["v2x"]]
-    env = dict(os.environ, PALCAS_NO_BUILD="1", PALCAS_SHOW="^$")
+        argv += ["--v2x", settings["v2x"]]
     start = time.time()
     with open(d / "point.log", "w") as log:
-        # Its own process group, so stop_children() can end roslaunch and every node with it.
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env,
-                                start_new_session=True)
-        with _children_lock:
-            _children.add(proc)
+        point_console = Console(out=log, err=log)
         try:
-            code = proc.wait()
-        finally:
-            with _children_lock:
-                _children.discard(proc)
+            code = run.execute(run.check(argv), point_console, show=None)
+        except OptionError as e:
+            point_console.error(str(e))
+            code = 2
+        except Exception:  # noqa: BLE001 - one point's fault fails that point, not the experiment
+            log.write(traceback.format_exc())
+            code = 1
     wall = time.time() - start
     ok = code == 0 and metrics_complete(out, p, settings["duration_s"])
     record = {"name": name, "arm": p["arm"], "pr": p["pr"], "seed": p["seed"], "demand": p["demand"],
               "status": "done" if ok else "failed", "exit_code": code, "wall_s": round(wall, 1),
-              "command": " ".join(shlex.quote(c) for c in cmd), "host": os.uname().nodename}
+              "command": shlex.join([str(ROOT / "palcas"), "run"] + argv), "host": os.uname().nodename}
     if not ok:
         record["error"] = last_error(d / "point.log", d / p["arm"] / "console.log")
     tmp = d / "point.json.tmp"
     tmp.write_text(json.dumps(record, indent=1) + "\n")
     tmp.replace(d / "point.json")
-    return 0 if ok else 1
+    return 0 if ok else code or 1
 
 
 def write_plan(out, settings):
@@ -379,7 +347,7 @@ def run_all(out, settings, jobs):
         except (KeyboardInterrupt, SystemExit):
             for f in futures:
                 f.cancel()
-            stop_children()
+            launch.stop_all(grace_s=30.0)
             raise
     return state["failed"]
 
@@ -396,8 +364,6 @@ def common_options(p):
     p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
     p.add_argument("--policy", action="append", metavar="ARM=DIR")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    p.add_argument("--check-only", action="store_true",
-                   help="validate the options against DIR and exit (nothing written)")
 
 
 class Parser(argparse.ArgumentParser):
@@ -405,45 +371,77 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def main(argv):
-    ap = Parser(prog="experiment.py", description=__doc__,
+MODES = {"--plan": "plan", "--collect": "collect"}
+
+
+def parse(argv):
+    """./palcas experiment's command line as (mode, options): run, plan, collect or point."""
+    mode, rest, words = "run", [], list(argv)
+    while words:
+        word = words.pop(0)
+        if word in MODES:
+            mode = MODES[word]
+        elif word == "--point":
+            mode = "point"
+            rest += ["--name"] + words[:1]
+            words = words[1:]
+        else:
+            rest.append(word)
+    ap = Parser(prog="./palcas experiment", description=__doc__,
                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = ap.add_subparsers(dest="cmd", required=True)
-    common_options(sub.add_parser("run"))
-    common_options(sub.add_parser("plan"))
-    pp = sub.add_parser("point")
-    pp.add_argument("--out", required=True)
-    pp.add_argument("--name", required=True)
-    pc = sub.add_parser("collect")
-    pc.add_argument("--out", required=True)
-    a = ap.parse_args(argv)
+    if mode in ("run", "plan"):
+        common_options(ap)
+    else:
+        ap.add_argument("--out", required=True)
+        if mode == "point":
+            ap.add_argument("--name", required=True)
+    return mode, ap.parse_args(rest)
+
+
+def check(argv):
+    """The experiment's mode, options and settings, checked against DIR's (nothing written);
+    raises UsageError."""
+    mode, a = parse(argv)
     out = pathlib.Path(a.out).resolve()
-    if a.cmd == "point":
+    if mode in ("collect", "point"):
         if not (out / "experiment.json").exists():
-            raise UsageError(f"{out}: no experiment.json (run 'plan' first)")
-        signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
-        try:
-            return run_point(out, a.name)
-        except (KeyboardInterrupt, SystemExit):
-            stop_children()
-            raise
-    if a.cmd == "collect":
-        if not (out / "experiment.json").exists():
-            raise UsageError(f"{out}: no experiment.json, not an experiment folder")
-        settings = json.loads((out / "experiment.json").read_text())
-        return experiment_results.collect(out, settings, points_of(settings))
+            raise UsageError(f"{out}: no experiment.json, not an experiment folder" if mode == "collect"
+                             else f"{out}: no experiment.json (run 'plan' first)")
+        return mode, a, out, None
     if a.jobs < 1:
         raise UsageError(f"--jobs: {a.jobs} must be >= 1")
-    settings = merge_settings(out, settings_from_args(a))
-    if a.check_only:
-        return 0
+    return mode, a, out, merge_settings(out, settings_from_args(a))
+
+
+def needs_workspace(argv):
+    """Planning and collecting run nothing: no build."""
+    return check(argv)[0] in ("run", "point")
+
+
+def main(argv):
+    try:
+        return experiment(*check(argv))
+    except KeyboardInterrupt:
+        print("[experiment] interrupted: finished points are kept; rerun the same command to "
+              "continue", file=sys.stderr)
+        return 130
+
+
+def experiment(mode, a, out, settings):
+    if mode == "point":
+        launch.handle_signals()
+        code = run_point(out, a.name)
+        return launch.Interrupted(launch.interrupted()).status if launch.interrupted() else code
+    if mode == "collect":
+        settings = json.loads((out / "experiment.json").read_text())
+        return experiment_results.collect(out, settings, points_of(settings))
     save_settings(out, settings)
     n = write_plan(out, settings)
-    if a.cmd == "plan":
+    if mode == "plan":
         print(f"[experiment] {n} point commands in {out / 'plan.txt'}; Slurm: sbatch "
               f"{out / 'slurm_array.sh'}; afterwards: ./palcas experiment --collect --out {out}")
         return 0
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # SystemExit: stop_children runs
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # SystemExit: the points are stopped
     failed = run_all(out, settings, a.jobs)
     code = experiment_results.collect(out, settings, points_of(settings))
     if failed:
@@ -451,15 +449,3 @@ def main(argv):
               f"(see their point.json; rerun the same command to retry them)", file=sys.stderr)
         return 1
     return code
-
-
-if __name__ == "__main__":
-    try:
-        sys.exit(main(sys.argv[1:]))
-    except UsageError as e:
-        print(f"[experiment] error: {e}", file=sys.stderr)
-        sys.exit(2)
-    except KeyboardInterrupt:
-        print("[experiment] interrupted: finished points are kept; rerun the same command to "
-              "continue", file=sys.stderr)
-        sys.exit(130)

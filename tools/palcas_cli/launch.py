@@ -1,0 +1,237 @@
+"""The launch runner: every roslaunch that run and train start goes through Launch (a free
+master port, the message key, the console log, the parent-death signal, SIGINT/SIGTERM), and
+every command reads its console with node_deaths / last_fatal: a command whose nodes died
+never reports success."""
+import os
+import re
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+from palcas_cli import ROOT
+
+ANSI = re.compile(r"\x1b\[[0-9;]*m")
+# What a run shows of its console on the terminal (the rest is in console.log);
+# $PALCAS_SHOW replaces it.
+SHOWN = r"palcas bridge: (episode|SUMO)|FATAL|ERROR"
+POLL_S = 0.2  # how often a waiting launch reads its console and looks at its helpers
+
+
+def free_port():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def ros_env(port, log_dir=None):
+    """The environment of a private master on PORT (its logs in LOG_DIR)."""
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:%d" % port, ROS_HOSTNAME="127.0.0.1")
+    if log_dir:
+        env["ROS_LOG_DIR"] = str(log_dir)
+    return env
+
+
+def message_key(folder):
+    """<folder>/auth.key: the run's or training's random message key (palcas_common/README.md),
+    hex, readable by its owner only, made on first use. Every node of the run reads it: RSUs
+    sign advisories and submissions, the bridge and the server refuse the rest."""
+    key = os.path.join(folder, "auth.key")
+    if not (os.path.isfile(key) and os.path.getsize(key) > 0):
+        tmp = key + ".tmp"
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(os.urandom(32).hex())
+        os.replace(tmp, key)
+    return key
+
+
+def git_commit():
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True,
+                              check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def read_text(path):
+    try:
+        with open(path, errors="replace") as f:
+            return f.read()
+    except OSError:
+        return ""
+
+
+def node_deaths(console_text):
+    """Nodes of a roslaunch console that died for good: a non-zero exit that roslaunch did not
+    follow with a restart (respawn), or three deaths (a crash loop); a node that died once and
+    came back is not lost. 'name (exit code N[, died k times])', sorted by name."""
+    text = ANSI.sub("", console_text)
+    deaths, restarts, codes = {}, {}, {}
+    for m in re.finditer(r"\[([^\[\]\s]+)\] process has died \[pid \d+, exit code (-?\d+)", text):
+        if m.group(2) != "0":
+            deaths[m.group(1)] = deaths.get(m.group(1), 0) + 1
+            codes[m.group(1)] = m.group(2)
+    for m in re.finditer(r"\[([^\[\]\s]+)\] restarting process", text):
+        restarts[m.group(1)] = restarts.get(m.group(1), 0) + 1
+    lost = []
+    for node in sorted(deaths):
+        d, r = deaths[node], restarts.get(node, 0)
+        if d > r or d >= 3:
+            lost.append("%s (exit code %s%s)" % (node, codes[node], ", died %d times" % d if d > 1 else ""))
+    return lost
+
+
+def last_fatal(console_text):
+    """The last FATAL/ERROR line or SUMO assertion, shortened."""
+    lines = [line for line in ANSI.sub("", console_text).splitlines()
+             if re.search(r"\[(FATAL|ERROR)\]|Assertion .* failed|Segmentation fault", line)]
+    return lines[-1][:400] if lines else ""
+
+
+def crash_reason(console_text):
+    """Why a simulation ended early: its own error first (an RSU killed on the way is not why)."""
+    text = ANSI.sub("", console_text)
+    found = re.findall(r"(?:Assertion.*|Segmentation fault.*|\[FATAL\].*)", text)
+    if found:
+        return found[-1][:200]
+    died = re.search(r"process has died.*", text)
+    return died.group(0)[:200] if died else ""
+
+
+class Interrupted(Exception):
+    """The command was stopped by SIGINT or SIGTERM; every launch of it has stopped."""
+
+    def __init__(self, name):
+        super().__init__(name)
+        self.signal = name
+        self.status = 130 if name == "INT" else 143
+
+
+_live = set()  # launches under way, for the signal handler and stop_all
+_live_lock = threading.Lock()
+_stopping = {"signal": None}
+
+
+def interrupted():
+    """INT or TERM once the command was told to stop, else None."""
+    return _stopping["signal"]
+
+
+def handle_signals():
+    """SIGINT (Ctrl-C) or SIGTERM (a scheduler, kill) of the command: remembered, and SIGINT
+    goes to every launch under way, which then stops its nodes (a training's checkpoint)."""
+    def stop(signum, _frame):
+        _stopping["signal"] = "INT" if signum == signal.SIGINT else "TERM"
+        with _live_lock:
+            launches = list(_live)
+        for launch in launches:
+            launch.interrupt()
+    signal.signal(signal.SIGINT, stop)
+    signal.signal(signal.SIGTERM, stop)
+
+
+def stop_all(grace_s=30.0):
+    """SIGINT to every launch under way, SIGKILL to what is left of them after grace_s: a
+    command stopped from another thread (./palcas experiment) leaves no process behind."""
+    _stopping["signal"] = _stopping["signal"] or "INT"
+    with _live_lock:
+        launches = list(_live)
+    for launch in launches:
+        launch.interrupt()
+    deadline = time.time() + grace_s
+    for launch in launches:
+        launch.kill_after(deadline)
+
+
+class Launch:
+    """One roslaunch on a free master port, its console in a file (appended to with append),
+    lines matching `show` (a regex, None = nothing) also written to `shown`, ANSI colours
+    removed. roslaunch runs in its own process group with a parent-death signal: if this
+    process is killed outright (SIGKILL, no handler runs), roslaunch still gets SIGINT and stops
+    every node (test/faults/train_sigkill_test.sh). Success is judged by what the run writes,
+    not by roslaunch's status."""
+
+    def __init__(self, args, console, log_dir, append=False, show=None, shown=None):
+        self.args, self.console, self.log_dir = list(args), str(console), str(log_dir)
+        self.append, self.show = append, re.compile(show) if show else None
+        self.shown = shown or sys.stdout
+        self.port, self.process, self._offset, self._partial = None, None, 0, ""
+
+    def start(self):
+        if interrupted():  # the command was stopped before this launch: none starts
+            raise Interrupted(interrupted())
+        self.port = free_port()
+        mode = "a" if self.append else "w"
+        with open(self.console, mode) as console:
+            self._offset = console.tell()
+            self.process = subprocess.Popen(
+                ["setpriv", "--pdeathsig", "INT", "roslaunch", "-p", str(self.port)] + self.args,
+                stdout=console, stderr=subprocess.STDOUT, env=ros_env(self.port, self.log_dir),
+                start_new_session=True)
+        with _live_lock:
+            _live.add(self)
+        if interrupted():  # stopped while it started
+            self.interrupt()
+        return self
+
+    def wait(self, tick=None):
+        """Waits for roslaunch to end, showing its console; tick() runs every POLL_S meanwhile
+        (in the calling thread). Returns roslaunch's exit status; raises Interrupted if the
+        command was stopped meanwhile."""
+        try:
+            while True:
+                try:
+                    status = self.process.wait(timeout=POLL_S)
+                    break
+                except subprocess.TimeoutExpired:
+                    self._follow()
+                    if tick:
+                        tick()
+        finally:
+            with _live_lock:
+                _live.discard(self)
+        self._follow(final=True)
+        if interrupted():
+            raise Interrupted(interrupted())
+        return status
+
+    def running(self):
+        return self.process is not None and self.process.poll() is None
+
+    def interrupt(self):
+        if self.running():
+            try:
+                self.process.send_signal(signal.SIGINT)
+            except ProcessLookupError:
+                pass
+
+    def kill_after(self, deadline):
+        try:
+            self.process.wait(timeout=max(0.1, deadline - time.time()))
+        except subprocess.TimeoutExpired:
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+    def _follow(self, final=False):
+        if not self.show:
+            return
+        try:
+            with open(self.console, errors="replace") as f:
+                f.seek(self._offset)
+                text = f.read()
+                self._offset = f.tell()
+        except OSError:
+            return
+        lines = (self._partial + text).split("\n")
+        self._partial = "" if final else lines.pop()
+        for line in lines:
+            if line and self.show.search(line):
+                self.shown.write(ANSI.sub("", line) + "\n")
+        self.shown.flush()
