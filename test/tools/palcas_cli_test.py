@@ -16,6 +16,7 @@ import stat
 import sys
 import tempfile
 import threading
+import time
 import unittest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -34,10 +35,11 @@ out=""
 for a in "$@"; do case "$a" in out_dir:=*) out="${a#out_dir:=}" ;; esac; done
 tr '\0' ' ' </proc/$PPID/cmdline >"$FAKE_NOTES/parent"
 printf '%s\n' "$@" >"$FAKE_NOTES/args"
+# Trap first: a test stops it once it has printed that SUMO started.
+[ -z "${FAKE_WAITS:-}" ] || trap 'echo "[rsu_0/rsu-2] process has died [pid 9, exit code -2, cmd x]"; exit 0' INT
 echo "... logging to $ROS_LOG_DIR (master $ROS_MASTER_URI)"
 printf '\033[32mpalcas bridge: SUMO 1.15 started\033[0m\n'
 if [ -n "${FAKE_WAITS:-}" ]; then
-  trap 'echo "[rsu_0/rsu-2] process has died [pid 9, exit code -2, cmd x]"; exit 0' INT
   while :; do sleep 0.05; done
 fi
 if [ -n "${FAKE_DIES:-}" ]; then
@@ -225,7 +227,15 @@ class LaunchRunner(unittest.TestCase):
     def test_sigint_reaches_the_launch_and_the_wait_says_interrupted(self):
         os.environ["FAKE_WAITS"] = "1"
         lx = launch.Launch(["x"], self.out / "console.log", self.out / "ros_log").start()
-        stopper = threading.Timer(0.5, launch.stop_all, kwargs={"grace_s": 10})
+
+        def stop_once_started():  # a loaded machine may take longer than any fixed delay
+            console = self.out / "console.log"
+            for _ in range(400):
+                if console.exists() and "SUMO 1.15 started" in console.read_text():
+                    break
+                time.sleep(0.05)
+            launch.stop_all(grace_s=10)
+        stopper = threading.Thread(target=stop_once_started)
         stopper.start()
         with self.assertRaises(launch.Interrupted) as e:
             lx.wait()

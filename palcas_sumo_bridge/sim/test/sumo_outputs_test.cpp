@@ -55,13 +55,19 @@ TEST(SumoOutputArgs, BadInputIsRefusedNamingIt) {
 }
 
 TEST(SumoOutputArgs, ThePalcasCommandKnowsTheSameNames) {
-  // ./palcas run --sumo-output checks names before anything starts, from its own list.
-  const std::string script = palcas::sim::test::slurp(std::string(PALCAS_CONFIG_DIR) + "/../palcas");
-  const std::string key = "SUMO_OUTPUTS=\"";
+  // ./palcas run --sumo-output checks names before anything starts, from its own list
+  // (tools/palcas_cli/options.py: SUMO_OUTPUTS = ("fcd", "tripinfo", ...)).
+  const std::string script =
+      palcas::sim::test::slurp(std::string(PALCAS_CONFIG_DIR) + "/../tools/palcas_cli/options.py");
+  const std::string key = "SUMO_OUTPUTS = (";
   const auto at = script.find(key);
-  ASSERT_NE(at, std::string::npos) << "no SUMO_OUTPUTS= line in ./palcas";
-  const auto end = script.find('"', at + key.size());
-  std::string listed = script.substr(at + key.size(), end - at - key.size()), known;
+  ASSERT_NE(at, std::string::npos) << "no SUMO_OUTPUTS = (...) line in tools/palcas_cli/options.py";
+  const auto end = script.find(')', at + key.size());
+  std::string listed;
+  for (char c : script.substr(at + key.size(), end - at - key.size()))
+    if (c == ',') listed += ' ';
+    else if (c != '"' && c != ' ') listed += c;
+  std::string known;
   for (const auto& kind : sumoOutputKinds()) known += (known.empty() ? "" : " ") + std::string(kind.name);
   EXPECT_EQ(listed, known);
 }
