@@ -68,6 +68,14 @@ RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHa
   return o;
 }
 
+/// The decision inputs to wait for: the step's events, and with I2I between zones the
+/// neighbours' cluster states (the whole-road RSU has no neighbour).
+DecisionInputs decisionInputsOf(const RsuNodeOptions& o) {
+  const int zones = std::max(static_cast<int>(o.zones_m.size()) - 1, o.controller.cluster_index + 1);
+  return DecisionInputs(o.controller.cluster_index, zones, o.i2i && !o.whole_road,
+                        static_cast<std::uint64_t>(o.decision_period_steps));
+}
+
 }  // namespace
 
 RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -77,7 +85,8 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
       schedule_(scheduleOf(options_)),
       peers_(options_.controller.cluster_index, options_.i2i_stale_after_s),
       learning_log_(options_.checkpoint_dir.empty() ? "" : (fs::path(checkpointDir()) / "learning.csv").string(),
-                    options_.controller.rsu_id, options_.controller.train ? "train" : "eval") {
+                    options_.controller.rsu_id, options_.controller.train ? "train" : "eval"),
+      inputs_(decisionInputsOf(options_)) {
   const RsuControllerOptions& c = options_.controller;
   if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
     // A new training, or one that stopped before this RSU wrote anything: start afresh.
@@ -96,12 +105,16 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   advisories_pub_ = nh_.advertise<palcas_msgs::AdvisoryArray>(ADVISORIES_TOPIC, 10);
   cluster_pub_ = nh_.advertise<palcas_msgs::ClusterState>(CLUSTER_STATES_TOPIC, 10);
   status_pub_ = nh_.advertise<palcas_msgs::RsuStatus>(RSU_STATUS_TOPIC, 10);
-  states_sub_ = nh_.subscribe(VEHICLE_STATES_TOPIC, 10, &RsuNode::onStates, this,
+  // Room for the steps between two decisions and more: the bridge waits only for decisions.
+  states_sub_ = nh_.subscribe(VEHICLE_STATES_TOPIC, 1000, &RsuNode::onStates, this,
                               ros::TransportHints().tcpNoDelay());
-  events_sub_ = nh_.subscribe(VEHICLE_EVENTS_TOPIC, 100, &RsuNode::onEvents, this,
+  events_sub_ = nh_.subscribe(VEHICLE_EVENTS_TOPIC, 1000, &RsuNode::onEvents, this,
                               ros::TransportHints().tcpNoDelay());
   if (options_.i2i)
     cluster_sub_ = nh_.subscribe(CLUSTER_STATES_TOPIC, 20, &RsuNode::onClusterState, this);
+  held_timer_ = nh_.createWallTimer(
+      ros::WallDuration(std::max(options_.decision_inputs_wait_s, 1e-6)),
+      [this](const ros::WallTimerEvent&) { decideHeldAnyway("the wait ran out"); }, true, false);
   diagnostics_.setHardwareID(c.rsu_id);
   diagnostics_.add("decisions", this, &RsuNode::diagnose);
   waitForPeers();
@@ -204,19 +217,38 @@ void RsuNode::registerWithBridge() {
   if (const auto road = common::bridgeRoad(nh_)) checkAgainstRoad(options_, road->zones_m, road->num_lanes);
   // Registering starts the bridge's step 0: make sure its states reach us first.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
-  while (ros::ok() && states_sub_.getNumPublishers() == 0 && ros::WallTime::now() < deadline)
+  // Its events too: a decision waits for its step's event array (DecisionInputs).
+  while (ros::ok() && (states_sub_.getNumPublishers() == 0 || events_sub_.getNumPublishers() == 0) &&
+         ros::WallTime::now() < deadline)
     ros::WallDuration(0.02).sleep();
   palcas_msgs::RegisterRsu srv;
   srv.request.rsu_id = options_.controller.rsu_id;
-  if (!client.call(srv) || !srv.response.accepted)
+  // Answering only decision steps spares the bridge a round trip on the steps between them
+  // (the states still come every step, in order, and are observed).
+  srv.request.answer_period_steps = static_cast<std::uint32_t>(options_.decision_period_steps);
+  if (!client.call(srv) || !srv.response.accepted) {
     ROS_WARN_NAMED("startup", "%s: registration refused: %s", options_.controller.rsu_id.c_str(),
              srv.response.reason.c_str());
+    return;
+  }
+  answer_decision_steps_only_ = true;
 }
 
-void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) { addOutcomes(*msg, outcomes_); }
+void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) {
+  addOutcomes(*msg, outcomes_);
+  inputs_.eventsArrived(msg->step);
+  decideHeldIfReady();
+}
 
 void RsuNode::onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
   if (msg->rsu_id == options_.controller.rsu_id) return;
+  // It arrived, whatever the channel makes of it: a lost one is not waited for.
+  inputs_.clusterStateArrived(msg->cluster_index, msg->step);
+  receiveClusterState(msg);
+  decideHeldIfReady();
+}
+
+void RsuNode::receiveClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
   if (channel_) {
     // I2I over the channel: lost, or held until the step it arrives at (decide() takes it).
     ++i2i_received_;
@@ -261,11 +293,13 @@ void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
     i2i_in_flight_.clear();
   }
   last_state_step_ = msg->step;
+  if (held_state_) decideHeldAnyway("the bridge sent a later step");  // it did not wait for us
   if (schedule_.decidesAt(msg->step)) {
-    decide(*msg, received);
+    decideWhenReady(msg, received);
     return;
   }
-  answerEmpty(*msg, received);
+  // Unregistered, the bridge does not know our period and waits for every step.
+  if (!answer_decision_steps_only_) answerEmpty(*msg, received);
   const bool observe = schedule_.observesBetweenDecisions();
   if (observe || uplink_) {
     try {
@@ -292,6 +326,43 @@ void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::
 void RsuNode::publishAdvisories(palcas_msgs::AdvisoryArray& out) {
   common::signMessage(out, auth_key_.get());
   advisories_pub_.publish(out);
+}
+
+void RsuNode::decideWhenReady(const palcas_msgs::VehicleStateArray::ConstPtr& msg, const ros::WallTime& received) {
+  if (inputs_.ready(msg->step)) {
+    decide(*msg, received);
+    return;
+  }
+  ++decisions_held_;
+  held_state_ = msg;
+  held_received_ = received;
+  held_timer_.stop();
+  held_timer_.setPeriod(ros::WallDuration(std::max(options_.decision_inputs_wait_s, 1e-6)));
+  held_timer_.start();
+}
+
+void RsuNode::decideHeldIfReady() {
+  if (!held_state_ || !inputs_.ready(held_state_->step)) return;
+  held_timer_.stop();
+  const palcas_msgs::VehicleStateArray::ConstPtr msg = std::move(held_state_);
+  held_state_.reset();
+  decide(*msg, held_received_);
+}
+
+void RsuNode::decideHeldAnyway(const char* why) {
+  if (!held_state_) return;
+  held_timer_.stop();
+  const palcas_msgs::VehicleStateArray::ConstPtr msg = std::move(held_state_);
+  held_state_.reset();
+  std::string missing;
+  for (const std::string& m : inputs_.missing(msg->step)) missing += (missing.empty() ? "" : ", ") + m;
+  ++decisions_without_inputs_;
+  std::string down;
+  for (int k : inputs_.gaveUp(msg->step)) down += " " + std::to_string(k);
+  ROS_WARN_THROTTLE_NAMED(10.0, "decision", "%s: step %lu decided without %s (%s)%s", options_.controller.rsu_id.c_str(),
+                          static_cast<unsigned long>(msg->step), missing.c_str(), why,
+                          down.empty() ? "" : ("; not waiting again for cluster(s)" + down + " until heard").c_str());
+  decide(*msg, held_received_);
 }
 
 void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
@@ -354,8 +425,10 @@ float RsuNode::publishDecision(const palcas_msgs::VehicleStateArray& msg, const 
   out.i2i_downstream_density_veh_per_km = global.downstream;
   for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
   out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
-  publishAdvisories(out);
+  // The cluster state first: the peers then have it before the bridge, released by our
+  // answer, runs the steps to the next decision.
   if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, options_.controller, msg.step, decision.time_s));
+  publishAdvisories(out);
   return out.decision_ms;
 }
 
@@ -411,6 +484,11 @@ void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
   f.federation = options_.federation;
   f.decision_p99_ms = recent_decision_ms_.percentile(99.0);
   describeRsu(f, s);
+  s.add("decisions held for their events / neighbours' cluster states", decisions_held_);
+  s.add("decisions taken without them (wait ran out)", decisions_without_inputs_);
+  std::string down;
+  for (int k : inputs_.presumedDown()) down += (down.empty() ? "" : " ") + std::to_string(k);
+  s.add("neighbours presumed down (not waited for)", down.empty() ? "none" : down);
   addChannelCounts(s);
 }
 

@@ -59,6 +59,7 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   o.i2i = p.get<bool>("i2i", o.i2i);
   o.i2i_stale_after_s = p.number("i2i_stale_after_s", o.i2i_stale_after_s, 1e-3, 1e9);
   o.register_timeout_s = p.number("register_timeout_s", o.register_timeout_s, 0.0, 3600.0);
+  o.decision_inputs_wait_s = p.number("decision_inputs_wait_s", o.decision_inputs_wait_s, 0.0, 60.0);
   o.v2x = params::loadChannelParams(p);
   p.rejectUnknownKeys("palcas_rsu/README.md");
   if (!takesFromBridgeRoad(o)) c.validate();  // else adoptBridgeRoad validates

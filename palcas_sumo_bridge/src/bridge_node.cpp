@@ -116,10 +116,12 @@ void BridgeNode::advertise() {
 bool BridgeNode::onRegister(palcas_msgs::RegisterRsu::Request& req,
                             palcas_msgs::RegisterRsu::Response& res) {
   std::string reason;
-  res.accepted = runner_->lockstep().registerRsu(req.rsu_id, &reason);
+  res.accepted = runner_->lockstep().registerRsu(req.rsu_id, &reason, req.answer_period_steps);
   res.reason = reason;
   res.next_step = session().stepCount();
-  if (res.accepted) ROS_INFO_NAMED("startup", "palcas bridge: RSU '%s' registered", req.rsu_id.c_str());
+  if (res.accepted)
+    ROS_INFO_NAMED("startup", "palcas bridge: RSU '%s' registered; it answers every %u step(s)", req.rsu_id.c_str(),
+                   std::max<std::uint32_t>(req.answer_period_steps, 1));
   else ROS_WARN_NAMED("startup", "palcas bridge: refused registration: %s", reason.c_str());
   return true;
 }
@@ -168,19 +170,18 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
   current_states_.vehicles.clear();
   for (const sim::VehicleRecord& v : session.vehicles()) current_states_.vehicles.push_back(toMsg(v));
   // Measure from the published state only, so a bag of the episode reproduces it. The
-  // events of a step go out before its states: an RSU then usually has them when it
-  // decides (it does not rely on it: see RsuController's limbo).
+  // events of a step go out before its states, every step (empty too): an RSU decides a
+  // step only once it holds that step's array (palcas_rsu's DecisionInputs), since the
+  // bridge no longer waits for it between its decisions.
   const auto& sim_events = session.lastEvents();
   const std::vector<metrics::VehicleEvent> events = measure_->onStep(
       current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
-  if (!events.empty()) {
-    palcas_msgs::VehicleEventArray msg;
-    msg.header.stamp = stamp;
-    msg.header.frame_id = MAP_FRAME;
-    msg.step = step;
-    for (const auto& e : events) msg.events.push_back(toMsg(e));
-    events_pub_.publish(msg);
-  }
+  palcas_msgs::VehicleEventArray events_msg;
+  events_msg.header.stamp = stamp;
+  events_msg.header.frame_id = MAP_FRAME;
+  events_msg.step = step;
+  for (const auto& e : events) events_msg.events.push_back(toMsg(e));
+  events_pub_.publish(events_msg);
   states_pub_.publish(current_states_);
   if (options_.publish_tf && tf_pub_.getNumSubscribers() > 0)
     tf_pub_.publish(markers_->transforms(stamp, session.vehicles()));

@@ -32,7 +32,7 @@ class AdvisoryTest(unittest.TestCase):
         rospy.Subscriber("/vehicle_states", VehicleStateArray, cls.on_states, queue_size=100,
                          tcp_nodelay=True)
         rospy.wait_for_service("/register_rsu", timeout=WALL_TIMEOUT_S)
-        reply = rospy.ServiceProxy("/register_rsu", RegisterRsu)(cls.rsu_id)
+        reply = rospy.ServiceProxy("/register_rsu", RegisterRsu)(rsu_id=cls.rsu_id)
         assert reply.accepted, reply.reason
 
     @classmethod

@@ -6,7 +6,9 @@
 - after one federation round every RSU holds weights identical to the sample-weighted
   average that this test computes itself from what the RSUs submitted;
 - the bridge, every RSU and the federation server report on /diagnostics
-  (rqt_robot_monitor), lockstep and federation at OK on this healthy run.
+  (rqt_robot_monitor), lockstep and federation at OK on this healthy run;
+- the RSUs registered at their decision period answer only their decision steps, and the
+  bridge, waiting only for those, counts no late step.
 """
 import threading
 import time
@@ -30,6 +32,7 @@ class ClosedLoopTest(unittest.TestCase):
         cls.lock = threading.Lock()
         cls.states = {}      # step -> VehicleStateArray
         cls.advised = {}     # (step, rsu) -> [vehicle ids]
+        cls.off_period_answers = []  # (step, rsu) of arrays answering a step between decisions
         cls.event_steps = {}  # vehicle id -> steps with an event
         cls.submitted = {r: [] for r in cls.rsus}
         cls.models = {r: [] for r in cls.rsus}
@@ -50,6 +53,9 @@ class ClosedLoopTest(unittest.TestCase):
 
     @classmethod
     def on_advisories(cls, msg):
+        if msg.step % cls.period != 0:
+            with cls.lock:
+                cls.off_period_answers.append((msg.step, msg.rsu_id))
         if msg.step % cls.period == 0:
             with cls.lock:
                 cls.advised[(msg.step, msg.rsu_id)] = [a.vehicle_id for a in msg.advisories]
@@ -138,6 +144,9 @@ class ClosedLoopTest(unittest.TestCase):
                     for v in got:
                         history.setdefault(v, []).append((step, k))
         self.assertGreater(checked, 20, "too few CAVs in the zones to test anything")
+        with self.lock:
+            self.assertEqual(self.off_period_answers[:5], [],
+                             "RSUs answered steps between their decisions (the bridge waits only for decisions)")
         handed_over = [v for v, h in history.items() if len({k for _, k in h}) > 1]
         self.assertTrue(handed_over, "no CAV crossed between clusters during the test")
         for v in handed_over:

@@ -32,7 +32,7 @@ class LockstepTest(unittest.TestCase):
         rospy.Subscriber("/vehicle_states", VehicleStateArray, self.on_states, queue_size=10,
                          tcp_nodelay=True)
         rospy.wait_for_service("/register_rsu", timeout=60)
-        self.assertTrue(rospy.ServiceProxy("/register_rsu", RegisterRsu)(self.rsu_id).accepted)
+        self.assertTrue(rospy.ServiceProxy("/register_rsu", RegisterRsu)(rsu_id=self.rsu_id).accepted)
 
     def on_metrics(self, msg):
         with self.lock:

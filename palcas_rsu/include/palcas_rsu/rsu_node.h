@@ -1,7 +1,9 @@
 #pragma once
-// The RSU node: a thin ROS shell around palcas_core's RsuController. Per bridge step it
-// answers the lockstep (an AdvisoryArray, empty between decisions); at the decision steps
-// of its RsuSchedule it converts the state, calls the controller once for all its CAVs,
+// The RSU node: a thin ROS shell around palcas_core's RsuController. It registers with the
+// bridge at its decision period and answers the lockstep on its decision steps only (an
+// unregistered RSU answers every step, empty between decisions); at the decision steps
+// of its RsuSchedule, once its step's events and its neighbours' cluster states are in
+// (DecisionInputs), it converts the state, calls the controller once for all its CAVs,
 // publishes the advisories, its ClusterState (I2I) and its RsuStatus, then does what the
 // schedule says follows (learning, the federation client's tick, checkpoints).
 
@@ -22,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "palcas_rsu/decision_inputs.h"
 #include "palcas_rsu/federation_transport.h"
 #include "palcas_rsu/peer_states.h"
 #include "palcas_rsu/rsu_diagnostics.h"
@@ -44,7 +47,17 @@ class RsuNode {
   void onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg);
   void onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg);
   void onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg);
+  /// A peer's cluster state into PeerStates, through the V2X channel when it is on.
+  void receiveClusterState(const palcas_msgs::ClusterState::ConstPtr& msg);
   void decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received);
+  /// A decision step's state: decided now if its other inputs are in (DecisionInputs), else
+  /// held until they arrive or decision_inputs_wait_s has passed.
+  void decideWhenReady(const palcas_msgs::VehicleStateArray::ConstPtr& msg, const ros::WallTime& received);
+  /// Decides the held state if its inputs are now in (after an event array or a cluster state).
+  void decideHeldIfReady();
+  /// Decides the held state with what is there (the wait ran out, or a later state came):
+  /// the neighbours still missing are presumed down; said once per wait.
+  void decideHeldAnyway(const char* why);
   /// The controller's advice on what this RSU heard at the state's step, with the I2I
   /// densities it used (`global`). @throws std::invalid_argument for a malformed state.
   DecisionOutput advise(const palcas_msgs::VehicleStateArray& msg, double now_s, GlobalDensities& global);
@@ -111,6 +124,12 @@ class RsuNode {
   /// This zone's density at the previous decision: the "own" global density (veh/km).
   double last_own_density_ = std::numeric_limits<double>::quiet_NaN();
   bool first_state_ = true;
+  bool answer_decision_steps_only_ = false;  ///< registered with the bridge at our decision period
+  DecisionInputs inputs_;
+  palcas_msgs::VehicleStateArray::ConstPtr held_state_;  ///< a decision step waiting for its inputs
+  ros::WallTime held_received_;
+  ros::WallTimer held_timer_;
+  std::uint64_t decisions_held_ = 0, decisions_without_inputs_ = 0;
   diagnostic_updater::Updater diagnostics_;
   palcas_msgs::RsuStatus last_status_;  ///< of the last decision, for the diagnostics
   RecentTimes recent_decision_ms_{1000};

@@ -39,6 +39,10 @@ struct RsuNodeOptions {
   bool i2i = true;                   ///< false: no cluster-state exchange (global part unknown)
   double i2i_stale_after_s = 5.0;    ///< sim time after which a peer's state is stale [s]
   double register_timeout_s = 60.0;  ///< wall time to wait for the bridge's register service [s]
+  /// Wall time a decision waits for its step's events and the neighbours' cluster states of
+  /// the previous round (DecisionInputs) before deciding without them [s]. Below the bridge's
+  /// lockstep_deadline_s (0.2 s), so a wait that ends this way is not also a late step.
+  double decision_inputs_wait_s = 0.1;
   /// ~v2x/* (config/v2x.yaml): this RSU's side of the V2X channel, the vehicle states it
   /// hears (uplink) and the peers' cluster states (I2I). Off by default.
   v2x::ChannelParams v2x;

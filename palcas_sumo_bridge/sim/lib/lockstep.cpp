@@ -16,7 +16,8 @@ Lockstep::Lockstep(std::vector<std::string> expected_rsus, int lost_after_missed
   }
 }
 
-bool Lockstep::registerRsu(const std::string& rsu_id, std::string* reason) {
+bool Lockstep::registerRsu(const std::string& rsu_id, std::string* reason,
+                           std::uint32_t answer_period_steps) {
   auto it = rsus_.find(rsu_id);
   if (it == rsus_.end()) {
     if (reason) *reason = "RSU '" + rsu_id + "' is not in the bridge's expected_rsus";
@@ -25,6 +26,9 @@ bool Lockstep::registerRsu(const std::string& rsu_id, std::string* reason) {
   it->second.registered = true;
   it->second.lost = false;
   it->second.consecutive_misses = 0;
+  it->second.answer_period = answer_period_steps > 1 ? answer_period_steps : 1;
+  // Registered while a step is open: due on it only if it is one of its steps.
+  it->second.due = !step_open_ || open_step_ % it->second.answer_period == 0;
   return true;
 }
 
@@ -44,7 +48,10 @@ std::vector<std::string> Lockstep::unregistered() const {
 void Lockstep::beginStep(std::uint64_t step) {
   open_step_ = step;
   step_open_ = true;
-  for (auto& [id, s] : rsus_) s.answered = false;
+  for (auto& [id, s] : rsus_) {
+    s.answered = false;
+    s.due = step % s.answer_period == 0;
+  }
 }
 
 Lockstep::Answer Lockstep::onAnswer(const std::string& rsu_id, std::uint64_t step) {
@@ -72,21 +79,21 @@ Lockstep::Answer Lockstep::onAnswer(const std::string& rsu_id, std::uint64_t ste
 
 bool Lockstep::complete() const {
   for (const auto& [id, s] : rsus_)
-    if (s.registered && !s.lost && !s.answered) return false;
+    if (s.registered && s.due && !s.lost && !s.answered) return false;
   return true;
 }
 
 std::vector<std::string> Lockstep::waitingFor() const {
   std::vector<std::string> out;
   for (const auto& [id, s] : rsus_)
-    if (s.registered && !s.lost && !s.answered) out.push_back(id);
+    if (s.registered && s.due && !s.lost && !s.answered) out.push_back(id);
   return out;
 }
 
 std::vector<std::string> Lockstep::endStep(std::vector<std::string>* newly_lost) {
   std::vector<std::string> late;
   for (auto& [id, s] : rsus_) {
-    if (!s.registered || s.lost || s.answered) continue;
+    if (!s.registered || !s.due || s.lost || s.answered) continue;
     late.push_back(id);
     if (++s.consecutive_misses >= lost_after_) {
       s.lost = true;

@@ -108,3 +108,40 @@ TEST(Lockstep, RejectsBadConfiguration) {
   EXPECT_THROW(Lockstep({""}, 1), std::invalid_argument);
   EXPECT_THROW(Lockstep({"a"}, 0), std::invalid_argument);
 }
+
+TEST(Lockstep, AnRsuWithAnAnswerPeriodIsWaitedForOnlyOnItsSteps) {
+  Lockstep ls({"every", "tenth"}, 2);
+  std::string reason;
+  ASSERT_TRUE(ls.registerRsu("every", &reason, 0));  // 0 = every step, as before the period
+  ASSERT_TRUE(ls.registerRsu("tenth", &reason, 10));
+  std::vector<std::string> lost;
+  for (std::uint64_t step = 0; step < 25; ++step) {
+    ls.beginStep(step);
+    const bool tenth_due = step % 10 == 0;
+    const std::vector<std::string> waited =
+        tenth_due ? std::vector<std::string>{"every", "tenth"} : std::vector<std::string>{"every"};
+    EXPECT_EQ(ls.waitingFor(), waited) << "step " << step;
+    ls.onAnswer("every", step);
+    EXPECT_EQ(ls.complete(), !tenth_due) << "step " << step;
+    if (step == 0) ls.onAnswer("tenth", step);
+    // Steps 10 and 20 go unanswered: two misses of due steps, not the 15 steps between.
+    const std::vector<std::string> late = ls.endStep(&lost);
+    EXPECT_EQ(late.size(), step == 10 || step == 20 ? 1u : 0u) << "step " << step;
+    EXPECT_EQ(ls.isLive("tenth"), step < 20) << "step " << step;
+  }
+  EXPECT_EQ(lost, std::vector<std::string>{"tenth"});
+  EXPECT_EQ(ls.lateSteps(), 2u);
+}
+
+TEST(Lockstep, RegisteringDuringAStepIsDueOnlyIfTheStepIsItsOwn) {
+  Lockstep ls({"rsu_0"}, 3);
+  std::string reason;
+  ls.beginStep(7);
+  ASSERT_TRUE(ls.registerRsu("rsu_0", &reason, 10));
+  EXPECT_TRUE(ls.complete());  // step 7 is not one of its steps
+  ls.endStep(nullptr);
+  ls.beginStep(10);
+  EXPECT_FALSE(ls.complete());
+  EXPECT_EQ(ls.onAnswer("rsu_0", 10), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.complete());
+}

@@ -19,11 +19,14 @@ class Lockstep {
   Lockstep(std::vector<std::string> expected_rsus, int lost_after_missed_steps);
 
   /// Start handshake. @return false (with *reason) for an RSU that is not expected.
-  bool registerRsu(const std::string& rsu_id, std::string* reason);
+  /// An RSU with answer_period_steps N > 1 answers (and is waited for) only on steps that are
+  /// multiples of N, its decision steps: between them the bridge steps without a round trip.
+  bool registerRsu(const std::string& rsu_id, std::string* reason, std::uint32_t answer_period_steps = 1);
   bool allRegistered() const;
   std::vector<std::string> unregistered() const;
 
-  /// Opens step `step`: from now on answers for it count.
+  /// Opens step `step`: from now on answers for it count, and the RSUs due on it (period
+  /// dividing the step) are waited for.
   void beginStep(std::uint64_t step);
   enum class Answer { kAccepted, kUnknownRsu, kStale, kDuplicate };
   /// Records that `rsu_id` answered `step`. A lost RSU is live again when it answers the
@@ -33,11 +36,11 @@ class Lockstep {
   static constexpr std::uint64_t REVIVE_WINDOW_STEPS = 10;
   /// Lost RSUs revived by an answer since the last call (for the log), then cleared.
   std::vector<std::string> takeRevived();
-  /// True when every live, registered RSU has answered the open step.
+  /// True when every live, registered RSU due on the open step has answered it.
   bool complete() const;
-  /// Live RSUs that have not answered the open step yet.
+  /// Live RSUs due on the open step that have not answered it yet.
   std::vector<std::string> waitingFor() const;
-  /// Closes the open step. @return the RSUs that missed it (late). Updates lost status;
+  /// Closes the open step. @return the due RSUs that missed it (late). Updates lost status;
   /// *newly_lost receives the ones lost on this step.
   std::vector<std::string> endStep(std::vector<std::string>* newly_lost);
 
@@ -52,6 +55,8 @@ class Lockstep {
   struct RsuStatus {
     bool registered = false;
     bool answered = false;
+    bool due = true;                   ///< expected to answer the open step
+    std::uint32_t answer_period = 1;   ///< answers steps that are multiples of it
     bool lost = false;
     int consecutive_misses = 0;
     std::uint64_t late_answers = 0;
