@@ -23,6 +23,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from palcas_cli import experiment  # noqa: E402
 import eval_table  # noqa: E402
+import loop_cost  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
@@ -449,6 +450,45 @@ class FiguresTest(unittest.TestCase):
         names = {pathlib.Path(p).stem for p in pngs}
         self.assertTrue({"speed_over_time", "space_time_keep", "space_time_sumo_native",
                          "accel_profiles", "lane_trajectories"} <= names)
+
+
+class LoopCostTest(unittest.TestCase):
+    """tools/loop_cost.py: the per-step split weighted over the buckets, and each arm's wall
+    against sumo_native's of the same run."""
+
+    def test_parts_are_step_weighted_and_the_ratio_is_against_sumo_native(self):
+        d = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, d)
+        for arm in ("keep", "sumo_native"):
+            shutil.copytree(FIXTURE / arm, d / arm)
+        metrics = json.loads((d / "keep" / "metrics.json").read_text())
+        metrics["step_timing"] = [
+            dict(vehicles_from=0, vehicles_to=49, steps=100, sumo_ms_per_step=1.0, bridge_ms_per_step=0.1,
+                 lockstep_ms_per_step=0.0),
+            dict(vehicles_from=50, vehicles_to=99, steps=300, sumo_ms_per_step=3.0, bridge_ms_per_step=0.5,
+                 lockstep_ms_per_step=0.4)]
+        metrics["wall_seconds"] = 3.0
+        (d / "keep" / "metrics.json").write_text(json.dumps(metrics))
+        native_wall = json.loads((d / "sumo_native" / "metrics.json").read_text())["wall_seconds"]
+        by_arm = {r[1]: r for r in loop_cost.rows(d)}
+        _, _, steps, wall, sumo, bridge, lockstep, ratio = by_arm["keep"]
+        self.assertEqual(steps, 400)
+        self.assertAlmostEqual(sumo, 2.5)
+        self.assertAlmostEqual(bridge, 0.4)
+        self.assertAlmostEqual(lockstep, 0.3)
+        self.assertAlmostEqual(ratio, 3.0 / native_wall)
+        self.assertAlmostEqual(by_arm["sumo_native"][7], 1.0)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            loop_cost.main([str(d), "--markdown"])
+        self.assertIn("| wall / sumo_native |", out.getvalue())
+
+    def test_a_folder_without_arms_is_named(self):
+        d = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, d)
+        with self.assertRaises(SystemExit) as e:
+            list(loop_cost.rows(d))
+        self.assertIn(d, str(e.exception))
 
 
 def main():
