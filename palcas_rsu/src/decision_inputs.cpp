@@ -38,9 +38,11 @@ bool DecisionInputs::neighbourDue(int cluster, std::uint64_t step) const {
 
 std::vector<std::string> DecisionInputs::missing(std::uint64_t step) const {
   std::vector<std::string> out;
-  // Within an episode no event array after `step` can exist yet: the bridge publishes the
-  // next step only after this decision's answer.
-  if (!events_step_ || *events_step_ != step) out.push_back("events of step " + std::to_string(step));
+  // The array of `step` or a later one of the same round (the bridge went on without this
+  // RSU's answer); arrays arrive in order, so the earlier ones are in. A far larger step is
+  // the last episode's.
+  if (!events_step_ || *events_step_ < step || *events_step_ >= step + period_)
+    out.push_back("events of step " + std::to_string(step));
   for (int k : neighbours_)
     if (neighbourDue(k, step))
       out.push_back("cluster state of cluster " + std::to_string(k) + " for step " + std::to_string(step - period_));

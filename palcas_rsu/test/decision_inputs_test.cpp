@@ -40,12 +40,15 @@ TEST(DecisionInputs, ALaterDecisionWaitsForBothNeighboursOfThePreviousRound) {
   EXPECT_TRUE(in.ready(30));
 }
 
-TEST(DecisionInputs, EventsOfAnEarlierStepDoNotDo) {
+TEST(DecisionInputs, EventsOfAnEarlierStepDoNotDoALaterStepOfTheRoundDoes) {
   DecisionInputs in(0, 2, true, PERIOD);
   in.clusterStateArrived(1, 0);
-  in.eventsArrived(9);
+  in.eventsArrived(9);  // a step with events between two decisions
   EXPECT_EQ(in.missing(10), std::vector<std::string>{"events of step 10"});
   in.eventsArrived(10);
+  EXPECT_TRUE(in.ready(10));
+  // The bridge went on without this RSU's answer: the arrays of the steps after are in too.
+  in.eventsArrived(13);
   EXPECT_TRUE(in.ready(10));
 }
 

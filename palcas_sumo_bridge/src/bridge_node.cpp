@@ -170,18 +170,21 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
   current_states_.vehicles.clear();
   for (const sim::VehicleRecord& v : session.vehicles()) current_states_.vehicles.push_back(toMsg(v));
   // Measure from the published state only, so a bag of the episode reproduces it. The
-  // events of a step go out before its states, every step (empty too): an RSU decides a
-  // step only once it holds that step's array (palcas_rsu's DecisionInputs), since the
-  // bridge no longer waits for it between its decisions.
+  // events of a step go out before its states: on every step with events, and (empty) on
+  // every step an RSU may decide on. An RSU decides a step only once it holds that step's
+  // array (palcas_rsu's DecisionInputs), since the bridge does not wait for it between its
+  // decisions; on one topic the arrays arrive in order, so the earlier ones are in too.
   const auto& sim_events = session.lastEvents();
   const std::vector<metrics::VehicleEvent> events = measure_->onStep(
       current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
-  palcas_msgs::VehicleEventArray events_msg;
-  events_msg.header.stamp = stamp;
-  events_msg.header.frame_id = MAP_FRAME;
-  events_msg.step = step;
-  for (const auto& e : events) events_msg.events.push_back(toMsg(e));
-  events_pub_.publish(events_msg);
+  if (!events.empty() || runner_->lockstep().mayDecideOnOpenStep()) {
+    palcas_msgs::VehicleEventArray events_msg;
+    events_msg.header.stamp = stamp;
+    events_msg.header.frame_id = MAP_FRAME;
+    events_msg.step = step;
+    for (const auto& e : events) events_msg.events.push_back(toMsg(e));
+    events_pub_.publish(events_msg);
+  }
   states_pub_.publish(current_states_);
   if (options_.publish_tf && tf_pub_.getNumSubscribers() > 0)
     tf_pub_.publish(markers_->transforms(stamp, session.vehicles()));

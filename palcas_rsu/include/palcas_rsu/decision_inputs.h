@@ -4,8 +4,9 @@
 // two decisions states, vehicle events and the peers' cluster states stream in over separate
 // connections, in no fixed order against each other. A decision at step s is taken only
 // once this RSU holds
-//   - the bridge's events of step s (the bridge publishes an event array every step, before
-//     that step's states; on one topic they arrive in order), and
+//   - the bridge's events of step s (the bridge publishes an event array, empty too, before
+//     the states of every step an RSU is due on; on one topic they arrive in order, so the
+//     arrays of earlier steps with events are in too), and
 //   - each neighbour's cluster state of the previous decision round (stamped at or after
 //     s - period: the newest a decision at s may use, PeerStates::global),
 // so that the same seed gives the same decisions however the messages interleave. A

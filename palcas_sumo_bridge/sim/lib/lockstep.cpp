@@ -38,6 +38,13 @@ bool Lockstep::allRegistered() const {
   return true;
 }
 
+bool Lockstep::mayDecideOnOpenStep() const {
+  if (rsus_.empty()) return true;
+  for (const auto& [id, s] : rsus_)
+    if (!s.registered || s.due) return true;
+  return false;
+}
+
 std::vector<std::string> Lockstep::unregistered() const {
   std::vector<std::string> out;
   for (const auto& [id, s] : rsus_)

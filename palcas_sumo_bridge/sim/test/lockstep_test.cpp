@@ -145,3 +145,21 @@ TEST(Lockstep, RegisteringDuringAStepIsDueOnlyIfTheStepIsItsOwn) {
   EXPECT_EQ(ls.onAnswer("rsu_0", 10), Lockstep::Answer::kAccepted);
   EXPECT_TRUE(ls.complete());
 }
+
+TEST(Lockstep, AnRsuMayDecideOnlyOnItsStepsOnceEveryRsuIsRegistered) {
+  EXPECT_TRUE(Lockstep({}, 1).mayDecideOnOpenStep());  // free-running: periods unknown
+  Lockstep ls({"a", "b"}, 3);
+  std::string reason;
+  ls.beginStep(3);
+  EXPECT_TRUE(ls.mayDecideOnOpenStep());  // nobody registered: any step may be a decision
+  ASSERT_TRUE(ls.registerRsu("a", &reason, 10));
+  EXPECT_TRUE(ls.mayDecideOnOpenStep());  // "b" still unknown
+  ASSERT_TRUE(ls.registerRsu("b", &reason, 5));
+  EXPECT_FALSE(ls.mayDecideOnOpenStep());
+  ls.endStep(nullptr);
+  for (std::uint64_t step = 4; step <= 20; ++step) {
+    ls.beginStep(step);
+    EXPECT_EQ(ls.mayDecideOnOpenStep(), step % 5 == 0) << "step " << step;
+    ls.endStep(nullptr);
+  }
+}

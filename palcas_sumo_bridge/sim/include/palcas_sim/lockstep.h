@@ -45,6 +45,10 @@ class Lockstep {
   std::vector<std::string> endStep(std::vector<std::string>* newly_lost);
 
   bool enabled() const { return !rsus_.empty(); }
+  /// Whether an RSU may decide on the open step (and so waits for that step's vehicle event
+  /// array): free-running (no expected RSU), an expected RSU not registered yet (its period
+  /// is unknown), or a registered one due on it.
+  bool mayDecideOnOpenStep() const;
   bool isLive(const std::string& rsu_id) const;
   /// Registered RSUs currently considered lost.
   std::vector<std::string> lostRsus() const;
