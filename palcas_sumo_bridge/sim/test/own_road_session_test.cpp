@@ -1,5 +1,5 @@
 // The SUMO session on a user's own road (config/scenarios/curved: curved mainline, on-ramp,
-// off-ramp 640 m after it, lane drop 5 -> 4), in-process, the CAVs under advisory control
+// off-ramp about 760 m after it, lane drop 5 -> 4), in-process, the CAVs under advisory control
 // with no advice (the keep arm): every vehicle's x grows along the mainline through the curve,
 // lanes stay within the road's, the exit is served (a CAV in lane 1 before the off-ramp is
 // routed onto it), ramp traffic merges. One libsumo simulation per process: one test.

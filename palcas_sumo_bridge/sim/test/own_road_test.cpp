@@ -1,5 +1,5 @@
 // A user's own road (own_road.h): config/scenarios/curved (a curved mainline, an on-ramp with
-// an acceleration lane, an off-ramp 640 m after it, a lane drop 5 -> 4, edge names of its own)
+// an acceleration lane, an off-ramp about 760 m after it, a lane drop 5 -> 4, edge names of its own)
 // built with netconvert from its sources, the road found in it, its routes; and the errors a
 // user gets for a road that does not fit.
 #include <gtest/gtest.h>
