@@ -118,8 +118,10 @@ std::vector<std::string> foundMainline(const Graph& g) {
   int most = 0;
   for (const auto& [id, e] : g.edges()) {
     if (g.hasPredecessor(id)) continue;
+    if (e->lane_count < most) continue;
     if (e->lane_count > most) widest.clear();
-    if (e->lane_count >= most) widest.push_back(id), most = e->lane_count;
+    widest.push_back(id);
+    most = e->lane_count;
   }
   if (widest.empty())
     throw std::invalid_argument("no mainline found: every edge has a predecessor (a loop?); "
