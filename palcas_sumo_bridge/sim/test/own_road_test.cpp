@@ -212,6 +212,22 @@ TEST(OwnRoad, UserRouteFileGoesAfterTheVehicleTypes) {
                       "route_file 'absent.rou.xml': no such file");
 }
 
+TEST(OwnRoad, ANetXmlIsUsedAsItIs) {
+  // The network netconvert built from the sources, brought as a .net.xml instead.
+  const std::string dir = freshDir("own_road_net_xml_src");
+  const ScenarioFiles built = writeScenario(curvedConfig(), freshDir("own_road_net_xml_built"));
+  std::filesystem::copy(built.net_file, dir + "/mine.net.xml");
+  std::filesystem::copy(scenarioDir("curved") + "/vtypes.xml", dir + "/vtypes.xml");
+  ScenarioConfig c = curvedConfig();
+  c.scenario_dir = dir;
+  c.network_file = "mine.net.xml";
+  const ScenarioFiles files = writeScenario(c, freshDir("own_road_net_xml"));
+  EXPECT_EQ(slurp(files.net_file), slurp(built.net_file));
+  const OwnRoad road = discoverOwnRoad(readNetTopology(files.net_file), ownRoadOptions(c));
+  EXPECT_EQ(road.mainline, curvedRoad().mainline);
+  EXPECT_DOUBLE_EQ(road.mainline_length_m, curvedRoad().mainline_length_m);
+}
+
 // Hand-made topologies for the rule's corner cases (no netconvert needed).
 NetTopology straightRoad(const std::vector<std::tuple<std::string, std::string, std::string, int>>& edges,
                          const std::vector<std::pair<std::string, std::string>>& links) {
