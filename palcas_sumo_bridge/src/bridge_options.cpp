@@ -48,6 +48,9 @@ sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::Node
                              std::pair{"ramp_speed_limit_mps", &r.ramp_speed_limit_mps}})
     *value = p.number(std::string("scenario/road/") + name, *value, 1e-3, 1e6);
   c.generate_network = p.get<bool>("scenario/generate_network", c.generate_network);
+  c.network_file = p.get<std::string>("scenario/network_file", c.network_file);
+  c.mainline_edges = p.get<std::vector<std::string>>("scenario/mainline_edges", c.mainline_edges);
+  c.route_file = p.get<std::string>("scenario/route_file", c.route_file);
   c.penetration_rate = p.number("scenario/penetration_rate", c.penetration_rate, 0.0, 1.0);
   c.seed = static_cast<unsigned int>(p.integer("scenario/seed", static_cast<int>(c.seed), 0, 2147483647));
   c.duration_s = p.number("scenario/duration_s", c.duration_s, 0.1, 1e7);

@@ -1,5 +1,7 @@
 #include "palcas_sumo_bridge/msg_conversion.h"
 
+#include <cmath>
+
 namespace palcas::bridge {
 
 palcas_msgs::VehicleState toMsg(const sim::VehicleRecord& r) {
@@ -46,6 +48,10 @@ metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& s) {
   } else if (s.edge.compare(0, 4, "off_") == 0) {
     o.road_part = metrics::RoadPart::kOffRamp;
     o.part_cluster = std::stoi(s.edge.substr(4));
+  } else if (s.exit_cluster >= 0 && !std::isfinite(s.distance_to_exit_m)) {
+    // Off the mainline past its exit (any edge names: an own road): on its off-ramp.
+    o.road_part = metrics::RoadPart::kOffRamp;
+    o.part_cluster = s.exit_cluster;
   } else {
     o.road_part = metrics::RoadPart::kOnRamp;
     o.part_cluster = s.entry_cluster;

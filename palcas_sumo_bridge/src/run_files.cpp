@@ -68,7 +68,9 @@ json insertion(const sim::InsertionSettings& i) {
 
 json scenarioJson(const sim::ScenarioConfig& c) {
   json shares = json::object();  // the shares in effect: an empty map is the default rule
-  for (const auto& [source, dest] : c.route_shares.empty() ? sim::defaultRouteShares(c.road.clusters) : c.route_shares)
+  // (on an own road the default rule depends on its ramps: scenario/routes.rou.xml has the flows)
+  const bool default_rule_of_clusters = c.route_shares.empty() && c.network_file.empty();
+  for (const auto& [source, dest] : default_rule_of_clusters ? sim::defaultRouteShares(c.road.clusters) : c.route_shares)
     shares[source] = dest;
   const sim::RoadSpec& r = c.road;
   const json road = {{"clusters", r.clusters},
@@ -84,6 +86,9 @@ json scenarioJson(const sim::ScenarioConfig& c) {
   return {{"scenario_dir", c.scenario_dir},
           {"road", road},
           {"generate_network", c.generate_network},
+          {"network_file", c.network_file},
+          {"mainline_edges", c.mainline_edges},
+          {"route_file", c.route_file},
           {"penetration_rate", c.penetration_rate},
           {"seed", c.seed},
           {"duration_s", c.duration_s},
@@ -207,6 +212,10 @@ std::string episodeDir(const BridgeOptions& o, int episode) {
 sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg,
                                       int episode) {
   sim::SessionOptions s = o.session;
+  if (!o.scenario.network_file.empty()) {  // an own road: found again in the network SUMO runs
+    s.own_road_net_file = (fs::path(sumocfg).parent_path() / "network.net.xml").string();
+    s.own_road = sim::ownRoadOptions(o.scenario);
+  }
   // Teleports end a vehicle's trip (counted apart from collisions), so its outcome is decided.
   s.sumo_args = {"-c", sumocfg, "--time-to-teleport.remove", "true", "--no-step-log", "true",
                  "--duration-log.disable", "true",

@@ -122,7 +122,7 @@ visualization_msgs::MarkerArray RvizMarkers::dynamicMarkers(
   std::unordered_map<std::string, const sim::VehicleRecord*> by_id;
   for (const sim::VehicleRecord& v : vehicles) {
     // Its front at its position, like SUMO; a box longer than the car grows backwards.
-    cars.points.push_back(point(v.x_m - 0.5 * cars.scale.x, view_.drawnY(v.map_y_m), VEHICLE_Z));
+    cars.points.push_back(point(v.map_x_m - 0.5 * cars.scale.x, view_.drawnY(v.map_y_m), VEHICLE_Z));
     cars.colors.push_back(v.is_cav ? CAV_COLOUR : HDV_COLOUR);
     by_id[v.id] = &v;
   }
@@ -143,8 +143,8 @@ visualization_msgs::MarkerArray RvizMarkers::dynamicMarkers(
                                         : action == palcas_msgs::Advisory::ACCELERATE ? ACCELERATE_ARROW_PX
                                                                                        : KEEP_ARROW_PX);
     const double dy = change ? (left ? lane_drawn_m : -lane_drawn_m) : 0.0;  // left = +y in SUMO
-    const double x0 = v.x_m - 0.5 * cars.scale.x, y0 = view_.drawnY(v.map_y_m);
-    const double x1 = v.x_m + dx, y1 = y0 + dy;
+    const double x0 = v.map_x_m - 0.5 * cars.scale.x, y0 = view_.drawnY(v.map_y_m);
+    const double x1 = v.map_x_m + dx, y1 = y0 + dy;
     const double len = std::hypot(x1 - x0, y1 - y0);
     const double ux = (x1 - x0) / len, uy = (y1 - y0) / len;
     const auto colour = advisoryColour(action);
@@ -182,7 +182,7 @@ tf2_msgs::TFMessage RvizMarkers::transforms(const ros::Time& stamp,
     t.transform.rotation.w = std::cos(0.5 * yaw);
     out.transforms.push_back(t);
   };
-  for (const sim::VehicleRecord& v : vehicles) make("vehicle/" + v.id, v.x_m, v.map_y_m, v.heading_rad);
+  for (const sim::VehicleRecord& v : vehicles) make("vehicle/" + v.id, v.map_x_m, v.map_y_m, v.heading_rad);
   for (const sim::ClusterInfo& c : clusters_)
     make("rsu_" + std::to_string(c.index), 0.5 * (c.x_start_m + c.x_end_m), -10.0, 0.0);
   return out;

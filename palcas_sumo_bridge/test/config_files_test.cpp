@@ -49,6 +49,16 @@ TEST(ConfigFiles, TinyScenarioLoads) {
   EXPECT_EQ(o.scenario.road.num_lanes, 3);
 }
 
+TEST(ConfigFiles, OwnRoadScenarioLoads) {
+  // A user's own road: its network file and (here given) mainline reach the scenario.
+  const auto o = loadBridgeOptions(ros::NodeHandle("~curved"));
+  EXPECT_EQ(o.scenario.network_file, "curved.netccfg");
+  EXPECT_EQ(o.scenario.mainline_edges, (std::vector<std::string>{"west_in", "weave", "bend", "straight", "narrow"}));
+  EXPECT_TRUE(o.scenario.route_file.empty());
+  EXPECT_EQ(o.scenario.road.clusters, 2);
+  EXPECT_EQ(o.scenario.road.num_lanes, 5);
+}
+
 TEST(ConfigFiles, EveryKeyOfBridgeYamlEqualsTheCompiledInDefault) {
   // A key whose YAML value drifted from the code's default would make runs without the
   // YAML (tests, other launch files) behave differently.

@@ -92,6 +92,22 @@ TEST(MsgConversion, ObservationFollowsTheRoadPart) {
   EXPECT_THROW(toObservation(s), std::invalid_argument);
 }
 
+TEST(MsgConversion, OffRampOfAnOwnRoadIsKnownWithoutItsName) {
+  // A user's road names its ramps as it likes: off the mainline, past its exit = on its off-ramp.
+  auto s = toMsg(rampCav());
+  s.on_accel_lane = false;
+  s.lane = 0;
+  s.exit_cluster = 1;
+  s.edge = "slip_out";
+  s.distance_to_exit_m = std::numeric_limits<double>::infinity();
+  auto o = toObservation(s);
+  EXPECT_EQ(o.road_part, metrics::RoadPart::kOffRamp);
+  EXPECT_EQ(o.part_cluster, 1);
+  s.edge = "slip_in";  // before its exit: still on its on-ramp
+  s.distance_to_exit_m = 300.0;
+  EXPECT_EQ(toObservation(s).road_part, metrics::RoadPart::kOnRamp);
+}
+
 TEST(MsgConversion, VehicleEventRoundTrip) {
   metrics::VehicleEvent e;
   e.vehicle_id = "f_main_off1.3";

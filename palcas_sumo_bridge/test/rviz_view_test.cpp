@@ -133,6 +133,7 @@ TEST(RvizMarkers, OneArrowPerAdvisoryColouredByAction) {
   for (int i = 0; i < 3; ++i) {
     vehicles[i].id = "v" + std::to_string(i);
     vehicles[i].x_m = 100.0 * (i + 1);
+    vehicles[i].map_x_m = vehicles[i].x_m;  // drawn at its map position (the same on a straight road)
     vehicles[i].map_y_m = -4.8;
     vehicles[i].is_cav = true;
   }

@@ -1,5 +1,7 @@
 #include "palcas_sim/road_layout.h"
 
+#include "palcas_sim/own_road.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -48,11 +50,48 @@ RoadLayout::RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double c
     index_[e.id] = i;
   }
   const int cluster_count = std::max(1, static_cast<int>(std::ceil(mainline_length_m_ / cluster_length_m_ - 1e-9)));
+  std::vector<const EdgeInfo*> main;
+  for (const EdgeInfo& e : edges_)
+    if (e.part == RoadPart::kMainline) main.push_back(&e);
+  std::sort(main.begin(), main.end(), [](const EdgeInfo* a, const EdgeInfo* b) { return a->x_start_m < b->x_start_m; });
+  for (const EdgeInfo* e : main) mainline_.push_back(e->id);
+  buildClusters(cluster_count);
+  for (const ClusterInfo& c : clusters_)
+    if (!c.on_ramp_edge.empty() && c.merge_edge.empty())
+      throw std::invalid_argument("RoadLayout: cluster " + std::to_string(c.index) +
+                                  " has on-ramp '" + c.on_ramp_edge + "' but no merge edge");
+}
+
+RoadLayout::RoadLayout(const OwnRoad& road)
+    : edges_(road.edges), mainline_(road.mainline), internal_x_start_m_(road.internal_x_start_m),
+      measured_along_lanes_(true), num_main_lanes_(road.num_main_lanes),
+      cluster_length_m_(road.cluster_length_m), mainline_length_m_(road.mainline_length_m) {
+  if (mainline_.empty() || !(cluster_length_m_ > 0.0) || num_main_lanes_ < 1)
+    throw std::invalid_argument("RoadLayout: the road has no mainline");
+  for (std::size_t i = 0; i < edges_.size(); ++i) index_[edges_[i].id] = i;
+  buildClusters(road.clusters);
+  for (const auto& [zone, edge_id] : road.exit_from_edge) {
+    // The exit is where the mainline edge it leaves from ends (its ramp starts after the
+    // junction lane).
+    clusters_[zone].exit_from_edge = edge_id;
+    clusters_[zone].exit_x_m = edge(edge_id).x_end_m;
+  }
+  for (const auto& [zone, edge_id] : road.on_ramp_joins_edge) {
+    ClusterInfo& c = clusters_[zone];
+    c.on_ramp_joins_edge = edge_id;
+    // An on-ramp without an acceleration lane: its traffic joins where that edge starts.
+    if (c.merge_edge.empty()) c.accel_lane_x_start_m = edge(edge_id).x_start_m;
+  }
+}
+
+void RoadLayout::buildClusters(int cluster_count) {
   clusters_.resize(cluster_count);
   for (int k = 0; k < cluster_count; ++k) {
     clusters_[k].index = k;
     clusters_[k].x_start_m = k * cluster_length_m_;
-    clusters_[k].x_end_m = std::min((k + 1) * cluster_length_m_, mainline_length_m_);
+    clusters_[k].x_end_m = k + 1 == cluster_count && measured_along_lanes_
+                               ? mainline_length_m_
+                               : std::min((k + 1) * cluster_length_m_, mainline_length_m_);
   }
   for (const EdgeInfo& e : edges_) {
     if (e.cluster < 0) continue;
@@ -67,15 +106,27 @@ RoadLayout::RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double c
       c.exit_x_m = e.x_start_m;
     }
     if (e.has_accel_lane) {
-      c.merge_edge = e.id;
-      c.accel_lane_x_start_m = e.x_start_m;
-      c.accel_lane_length_m = e.x_end_m - e.x_start_m;
+      // An acceleration lane over several edges (own roads): from its first edge to its last.
+      if (c.merge_edge.empty() || e.x_start_m < c.accel_lane_x_start_m) {
+        const double end_m = c.merge_edge.empty() ? e.x_end_m : c.accel_lane_x_start_m + c.accel_lane_length_m;
+        c.merge_edge = e.id;
+        c.accel_lane_x_start_m = e.x_start_m;
+        c.accel_lane_length_m = end_m - e.x_start_m;
+      } else {
+        c.accel_lane_length_m = std::max(c.accel_lane_length_m, e.x_end_m - c.accel_lane_x_start_m);
+      }
     }
   }
-  for (const ClusterInfo& c : clusters_)
-    if (!c.on_ramp_edge.empty() && c.merge_edge.empty())
-      throw std::invalid_argument("RoadLayout: cluster " + std::to_string(c.index) +
-                                  " has on-ramp '" + c.on_ramp_edge + "' but no merge edge");
+}
+
+double RoadLayout::xAlongMainline(const std::string& edge_id, double lane_pos_m, double otherwise) const {
+  auto it = index_.find(edge_id);
+  if (it != index_.end()) {
+    const EdgeInfo& e = edges_[it->second];
+    return e.part == RoadPart::kUnknown ? otherwise : e.x_start_m + lane_pos_m;
+  }
+  auto internal = internal_x_start_m_.find(edge_id);
+  return internal == internal_x_start_m_.end() ? otherwise : internal->second + lane_pos_m;
 }
 
 const EdgeInfo& RoadLayout::edge(const std::string& id) const {

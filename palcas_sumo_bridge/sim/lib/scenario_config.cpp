@@ -158,7 +158,15 @@ std::map<std::string, RouteShares> defaultRouteShares(int num_clusters) {
 
 void validateScenarioConfig(const ScenarioConfig& c) {
   if (c.scenario_dir.empty()) throw std::invalid_argument("ScenarioConfig.scenario_dir is empty");
-  if (c.generate_network) {
+  if (!c.network_file.empty()) {  // an own road: its zone count and lane count
+    detail::validateRoadZones(c.road);
+    detail::validateRoadLanes(c.road);
+    for (const std::string& id : c.mainline_edges)
+      if (id.empty()) throw std::invalid_argument("ScenarioConfig.mainline_edges has an empty edge id");
+  } else if (!c.mainline_edges.empty() || !c.route_file.empty()) {
+    throw std::invalid_argument(std::string("ScenarioConfig.") + (c.route_file.empty() ? "mainline_edges" : "route_file") +
+                                " is only read with network_file (a road of the naming convention has its own)");
+  } else if (c.generate_network) {
     validateRoadSpec(c.road);
   } else {  // a hand-written network: only what describes any road of the naming convention
     detail::validateRoadZones(c.road);
@@ -244,6 +252,81 @@ std::vector<RouteDemand> buildRoutes(const ScenarioConfig& c, const std::vector<
     if (k.on_ramp_edge.empty()) continue;
     addSource("on" + std::to_string(k.index), k.accel_lane_x_start_m, k.on_ramp_edge,
               c.onramp_flow_vphpl * road.edge(k.on_ramp_edge).lane_count, k.index + 1);
+  }
+  return routes;
+}
+
+}  // namespace palcas::sim
+
+namespace palcas::sim {
+
+OwnRoadOptions ownRoadOptions(const ScenarioConfig& c) {
+  OwnRoadOptions o;
+  o.mainline_edges = c.mainline_edges;
+  o.clusters = c.road.clusters;
+  return o;
+}
+
+std::vector<RouteDemand> buildOwnRoadRoutes(const ScenarioConfig& c, const OwnRoad& own) {
+  validateScenarioConfig(c);
+  if (own.num_main_lanes != c.road.num_lanes)
+    throw std::invalid_argument("the network's mainline has " + std::to_string(own.num_main_lanes) +
+                                " lanes (its widest edge) but road/num_lanes is " + std::to_string(c.road.num_lanes) +
+                                ": set road/num_lanes to " + std::to_string(own.num_main_lanes));
+  const RoadLayout road(own);
+  const std::vector<std::string>& main = road.mainline();
+  // Exits reachable from a place on the mainline: those leaving after it.
+  auto exitsAfter = [&](double x_m) {
+    std::vector<const ClusterInfo*> exits;
+    for (const ClusterInfo& k : road.clusters())
+      if (!k.off_ramp_edge.empty() && k.exit_x_m > x_m + X_TOLERANCE_M) exits.push_back(&k);
+    return exits;
+  };
+  std::map<std::string, RouteShares> shares = c.route_shares;
+  auto defaultShares = [](const std::vector<const ClusterInfo*>& exits, double to_exits) {
+    RouteShares s;
+    s["end"] = exits.empty() ? 1.0 : 1.0 - to_exits;
+    for (const ClusterInfo* k : exits) s["off" + std::to_string(k->index)] = to_exits / exits.size();
+    return s;
+  };
+  struct Source {
+    std::string name, ramp, first_main;
+    std::vector<const ClusterInfo*> exits;
+    double vph;
+  };
+  std::vector<Source> sources;
+  const EdgeInfo& first = road.edge(main.front());
+  sources.push_back({"main", "", main.front(), exitsAfter(-1.0),
+                     c.mainline_flow_vphpl * (first.lane_count - (first.has_accel_lane ? 1 : 0))});
+  for (const ClusterInfo& k : road.clusters()) {
+    if (k.on_ramp_edge.empty()) continue;
+    sources.push_back({"on" + std::to_string(k.index), k.on_ramp_edge, k.on_ramp_joins_edge,
+                       exitsAfter(k.accel_lane_x_start_m + k.accel_lane_length_m),
+                       c.onramp_flow_vphpl * road.edge(k.on_ramp_edge).lane_count});
+  }
+  if (c.route_shares.empty())
+    for (const Source& s : sources) shares[s.name] = defaultShares(s.exits, s.ramp.empty() ? 0.45 : 0.6);
+  for (const auto& entry : shares)
+    if (std::none_of(sources.begin(), sources.end(), [&](const Source& s) { return s.name == entry.first; }))
+      throw std::invalid_argument("ScenarioConfig.route_shares: unknown source '" + entry.first + "'");
+  std::vector<RouteDemand> routes;
+  for (const Source& s : sources) {
+    std::vector<std::string> destinations{"end"};
+    for (const ClusterInfo* k : s.exits) destinations.push_back("off" + std::to_string(k->index));
+    const RouteShares& mine = checkedShares(shares, s.name, destinations);
+    const auto from = std::find(main.begin(), main.end(), s.first_main);
+    for (std::size_t d = 0; d < destinations.size(); ++d) {
+      RouteDemand r;
+      r.id = "r_" + s.name + "_" + destinations[d];
+      r.from_ramp = !s.ramp.empty();
+      if (r.from_ramp) r.edges.push_back(s.ramp);
+      const ClusterInfo* exit = d == 0 ? nullptr : s.exits[d - 1];
+      const auto to = exit ? std::find(main.begin(), main.end(), exit->exit_from_edge) : main.end() - 1;
+      r.edges.insert(r.edges.end(), from, to + 1);
+      if (exit) r.edges.push_back(exit->off_ramp_edge);
+      r.vehs_per_hour = s.vph * shareOf(mine, destinations[d]);
+      routes.push_back(r);
+    }
   }
   return routes;
 }

@@ -99,6 +99,39 @@ std::string generateNetwork(const std::string& scenario_dir, const std::string& 
   return net_file;
 }
 
+std::string prepareOwnNetwork(const ScenarioConfig& config, const std::string& out_dir) {
+  const fs::path source = fs::path(config.scenario_dir) / config.network_file;
+  if (!fs::is_regular_file(source))
+    throw std::invalid_argument("network_file '" + config.network_file + "': no such file in scenario_dir '" +
+                                config.scenario_dir + "'");
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw std::runtime_error("cannot create output folder '" + out_dir + "': " + ec.message());
+  const std::string net_file = (fs::path(out_dir) / "network.net.xml").string();
+  fs::remove(net_file, ec);  // never mistake a stale network for a fresh one
+  const std::string name = source.filename().string();
+  const auto endsWith = [&name](const std::string& suffix) {
+    return name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (endsWith(".net.xml")) {
+    fs::copy_file(source, net_file, fs::copy_options::overwrite_existing, ec);
+    if (ec) throw std::runtime_error("cannot copy '" + source.string() + "' to '" + net_file + "': " + ec.message());
+  } else if (endsWith(".netccfg")) {
+    // netconvert reads the paths in a configuration relative to the configuration itself.
+    const auto [status, output] = runCommand(shellQuote(config.netconvert_binary) + " -c " +
+                                             shellQuote(fs::absolute(source).string()) +
+                                             " --output-file " + shellQuote(net_file));
+    if (status != 0 || !fs::is_regular_file(net_file))
+      throw std::runtime_error("netconvert failed (status " + std::to_string(status) + ") on network_file '" +
+                               source.string() + "':\n" + output);
+  } else {
+    throw std::invalid_argument("network_file '" + config.network_file +
+                                "' is neither a SUMO network (*.net.xml) nor a netconvert configuration (*.netccfg)");
+  }
+  readNetText(net_file);  // a network at all
+  return net_file;
+}
+
 std::string generateNetwork(const RoadSpec& road, const std::string& out_dir,
                             const std::string& netconvert_binary) {
   const std::string sources = (fs::path(out_dir) / "sources").string();

@@ -62,8 +62,21 @@ void writeFile(const std::string& path, const std::string& content) {
   if (!out) throw std::runtime_error("cannot write '" + path + "'");
 }
 
+/// What is inside the <routes> element of a user's route file (its vehicle types, routes,
+/// flows and vehicles), to go after the generated vehicle types.
+std::string userRoutesBody(const std::string& path) {
+  const std::string text = xml::stripComments(xml::readFile(path));
+  const std::vector<xml::Tag> open = xml::findTags(text, "routes");
+  const std::size_t close = text.rfind("</routes>");
+  if (open.empty() || close == std::string::npos || close < open.front().offset)
+    throw std::invalid_argument("route_file '" + path + "' has no <routes> ... </routes> element");
+  const std::size_t body = text.find('>', open.front().offset);
+  if (body == std::string::npos || text[body - 1] == '/') return "";  // <routes/>
+  return text.substr(body + 1, close - body - 1);
+}
+
 std::string routesXml(const ScenarioConfig& c, const std::pair<Attributes, Attributes>& templates,
-                      const std::vector<RouteDemand>& routes) {
+                      const std::vector<RouteDemand>& routes, const std::string& user_routes = "") {
   const VTypeProbabilities p = vTypeProbabilities(c);
   std::ostringstream out;
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
@@ -90,6 +103,8 @@ std::string routesXml(const ScenarioConfig& c, const std::pair<Attributes, Attri
         << num(r.vehs_per_hour) << "\" departLane=\"" << s.depart_lane << "\" departPos=\""
         << s.depart_pos << "\" departSpeed=\"" << s.depart_speed << "\"/>\n";
   }
+  if (!user_routes.empty())
+    out << "    <!-- " << xml::escape(c.route_file) << " (route_file) -->" << user_routes << "\n";
   out << "</routes>\n";
   return out.str();
 }
@@ -132,12 +147,29 @@ ScenarioFiles writeScenario(const ScenarioConfig& config, const std::string& out
                                 "' is not a folder");
   const auto templates = readVTypeTemplates(config.scenario_dir);
   ScenarioFiles files;
+  files.routes_file = (fs::path(out_dir) / "routes.rou.xml").string();
+  files.sumocfg_file = (fs::path(out_dir) / "scenario.sumocfg").string();
+  if (!config.network_file.empty()) {  // an own road: found in the user's network
+    std::string user_routes;
+    if (!config.route_file.empty()) {
+      const fs::path route_file = fs::path(config.scenario_dir) / config.route_file;
+      if (!fs::is_regular_file(route_file))
+        throw std::invalid_argument("route_file '" + config.route_file + "': no such file in scenario_dir '" +
+                                    config.scenario_dir + "'");
+      user_routes = userRoutesBody(route_file.string());
+    }
+    files.net_file = prepareOwnNetwork(config, out_dir);
+    const OwnRoad road = discoverOwnRoad(readNetTopology(files.net_file), ownRoadOptions(config));
+    const std::vector<RouteDemand> routes = buildOwnRoadRoutes(config, road);  // checks the road too
+    writeFile(files.routes_file, routesXml(config, templates, user_routes.empty() ? routes : std::vector<RouteDemand>{},
+                                           user_routes));
+    writeFile(files.sumocfg_file, sumocfgXml(config));
+    return files;
+  }
   files.net_file = config.generate_network
                        ? generateNetwork(config.road, out_dir, config.netconvert_binary)
                        : generateNetwork(config.scenario_dir, out_dir, config.netconvert_binary);
   const std::vector<RouteDemand> routes = buildRoutes(config, readNetEdges(files.net_file));
-  files.routes_file = (fs::path(out_dir) / "routes.rou.xml").string();
-  files.sumocfg_file = (fs::path(out_dir) / "scenario.sumocfg").string();
   writeFile(files.routes_file, routesXml(config, templates, routes));
   writeFile(files.sumocfg_file, sumocfgXml(config));
   return files;

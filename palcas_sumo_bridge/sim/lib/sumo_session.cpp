@@ -64,7 +64,40 @@ SumoSession::~SumoSession() {
   }
 }
 
+void SumoSession::readOwnRoad() {
+  road_ = std::make_unique<RoadLayout>(discoverOwnRoad(readNetTopology(options_.own_road_net_file), options_.own_road));
+  for (const std::string& id : api::Edge::getIDList()) {
+    if (id.empty() || id[0] == ':') continue;  // junction-internal edges
+    for (int lane = 0; lane < api::Edge::getLaneNumber(id); ++lane) {
+      std::vector<std::pair<double, double>> line;
+      for (const auto& p : api::Lane::getShape(id + "_" + std::to_string(lane)).value)
+        line.emplace_back(p.x, p.y);
+      lane_shapes_.push_back(std::move(line));
+    }
+  }
+  options_.cluster_length_m = road_->clusterLengthM();  // the zones are the road's
+  const std::vector<std::string>& main = road_->mainline();
+  insertion_edge_ = main.front();
+  end_edge_ = main.back();
+  for (const ClusterInfo& c : road_->clusters())
+    if (!c.exit_from_edge.empty()) pre_exit_edge_[c.index] = c.exit_from_edge;
+  const EdgeInfo& first = road_->edge(main.front());
+  lane_width_m_ = api::Lane::getWidth(first.id + "_" + std::to_string(first.has_accel_lane ? 1 : 0));
+  // A SUMO lane index means another lane on the next edge when the lane count or the
+  // acceleration lane changes there (a merge edge, a lane drop).
+  for (std::size_t i = 0; i + 1 < main.size(); ++i) {
+    const EdgeInfo& e = road_->edge(main[i]);
+    const EdgeInfo& next = road_->edge(main[i + 1]);
+    if (e.lane_count != next.lane_count || e.has_accel_lane != next.has_accel_lane)
+      index_shift_ahead_.insert(e.id);
+  }
+}
+
 void SumoSession::readNetwork() {
+  if (!options_.own_road_net_file.empty()) {
+    readOwnRoad();
+    return;
+  }
   std::vector<EdgeInfo> edges;
   int main_lanes = 0;
   for (const std::string& id : api::Edge::getIDList()) {

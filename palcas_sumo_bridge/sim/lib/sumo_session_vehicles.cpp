@@ -31,6 +31,18 @@ void parseRouteId(const std::string& route_id, RouteKind* kind, int* entry_clust
   else *kind = exit < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
 }
 
+void SumoSession::classifyRouteByEdges(const std::vector<std::string>& edges, VehicleRecord* v) const {
+  v->entry_cluster = v->exit_cluster = -1;
+  for (const std::string& id : edges) {
+    if (!road_->hasEdge(id)) continue;
+    const EdgeInfo& e = road_->edge(id);
+    if (e.part == RoadPart::kOnRamp && v->entry_cluster < 0) v->entry_cluster = e.cluster;
+    if (e.part == RoadPart::kOffRamp && v->exit_cluster < 0) v->exit_cluster = e.cluster;
+  }
+  if (v->entry_cluster < 0) v->route_kind = v->exit_cluster < 0 ? RouteKind::kMainThrough : RouteKind::kMainExit;
+  else v->route_kind = v->exit_cluster < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
+}
+
 void SumoSession::removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed) {
   auto it = index_.find(id);
   if (it == index_.end()) return;
@@ -54,6 +66,8 @@ void SumoSession::onDeparted(const std::string& id) {
     parseRouteId(v.route_id, &v.route_kind, &v.entry_cluster, &v.exit_cluster);
   } catch (const std::invalid_argument&) {
     v.route_kind = RouteKind::kMainThrough;  // foreign routes: tracked, never controlled
+    // On an own road (a user's route file) the route's ramps say where it enters and leaves.
+    if (road_->measuredAlongLanes()) classifyRouteByEdges(api::Vehicle::getRoute(id), &v);
   }
   v.length_m = api::Vehicle::getLength(id);
   v.width_m = api::Vehicle::getWidth(id);
@@ -85,12 +99,14 @@ void SumoSession::readVehicles() {
     auto it = all.find(v.id);
     if (it == all.end()) continue;  // teleporting vehicles are off the road this step
     const libsumo::TraCIResults& r = it->second;
+    const double last_x_m = v.x_m;
     auto pos = r.find(libsumo::VAR_POSITION);
     if (pos != r.end())
       if (auto p = std::dynamic_pointer_cast<libsumo::TraCIPosition>(pos->second)) {
-        const double dx = p->x - v.x_m, dy = p->y - v.map_y_m;
+        const double dx = p->x - v.map_x_m, dy = p->y - v.map_y_m;
         if (dx * dx + dy * dy > 1e-6) v.heading_rad = std::atan2(dy, dx);
         v.x_m = p->x;
+        v.map_x_m = p->x;
         v.map_y_m = p->y;
       }
     v.speed_mps = asDouble(r, libsumo::VAR_SPEED);
@@ -99,6 +115,7 @@ void SumoSession::readVehicles() {
     splitLaneId(asString(r, libsumo::VAR_LANE_ID), &v.edge, &v.sumo_lane_index);
     v.lane_pos_m = asDouble(r, libsumo::VAR_LANEPOSITION);
     v.lateral_m = asDouble(r, libsumo::VAR_LANEPOSITION_LAT);  // offset in lane, refined below
+    if (road_->measuredAlongLanes()) v.x_m = road_->xAlongMainline(v.edge, v.lane_pos_m, last_x_m);
     updateDerived(v);
     if (v.lane_change_target != 0) continueLaneChange(v);
     if (v.is_cav && options_.advisory_control) {
@@ -123,6 +140,12 @@ void SumoSession::updateDerived(VehicleRecord& v) const {
   v.part_cluster = e.cluster;
   v.accel_lane_pos_m = v.on_accel_lane ? v.lane_pos_m : 0.0;
   v.accel_lane_length_m = v.on_accel_lane ? e.x_end_m - e.x_start_m : 0.0;
+  if (v.on_accel_lane && road_->measuredAlongLanes() && e.cluster >= 0) {
+    // An own road's acceleration lane may span several edges: measured over all of them.
+    const ClusterInfo& c = road_->clusters()[e.cluster];
+    v.accel_lane_pos_m = v.x_m - c.accel_lane_x_start_m;
+    v.accel_lane_length_m = c.accel_lane_length_m;
+  }
   // Lateral position from the right edge of lane 1; the acceleration lane and ramps sit
   // at negative values (one lane width to the right of lane 1).
   const int lane_for_lateral = v.part == RoadPart::kMainline ? v.lane : 0;

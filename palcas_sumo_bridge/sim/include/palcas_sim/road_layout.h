@@ -1,10 +1,13 @@
 #pragma once
-// What the bridge needs to know about the road, derived from the SUMO network by the edge
-// naming convention of config/scenarios (see config/scenarios/README.md):
+// What the bridge needs to know about the road. Either derived from the SUMO network by the
+// edge naming convention of config/scenarios (see config/scenarios/README.md), with x = SUMO's
+// x coordinate (a straight road along +x):
 //   main_*            mainline edges, running along +x from x = 0
 //   main_<k>_merge    the mainline edge of cluster k whose SUMO lane 0 is the acceleration lane
 //   on_<k>            the on-ramp of cluster k (joins main_<k>_merge's lane 0)
 //   off_<k>           the off-ramp of cluster k (leaves from lane 1, the rightmost main lane)
+// or taken from a road found in any network (own_road.h: a user's own road), with x measured
+// along the mainline's lanes.
 
 #include <map>
 #include <string>
@@ -31,12 +34,16 @@ struct ClusterInfo {
   double x_start_m = 0.0;       ///< zone [x_start_m, x_end_m) along the mainline
   double x_end_m = 0.0;
   std::string on_ramp_edge;     ///< "" when the cluster has no on-ramp
+  std::string on_ramp_joins_edge;  ///< the mainline edge the on-ramp joins ("" = its merge edge)
   std::string merge_edge;
   double accel_lane_x_start_m = 0.0;
   double accel_lane_length_m = 0.0;
   std::string off_ramp_edge;    ///< "" when the cluster has no off-ramp
   double exit_x_m = 0.0;        ///< x where the off-ramp leaves the mainline
+  std::string exit_from_edge;   ///< the mainline edge the off-ramp leaves from ("" = by x)
 };
+
+struct OwnRoad;
 
 /// Classifies edges by name and answers position questions.
 class RoadLayout {
@@ -45,6 +52,9 @@ class RoadLayout {
   /// @throws std::invalid_argument on a malformed name, a cluster without its merge edge,
   ///         or a non-positive cluster length.
   RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double cluster_length_m);
+  /// A road found by discoverOwnRoad (edges already classified, zones given).
+  /// @throws std::invalid_argument when it has no mainline.
+  explicit RoadLayout(const OwnRoad& road);
 
   /// @throws std::out_of_range naming the edge when it is not part of the network.
   const EdgeInfo& edge(const std::string& id) const;
@@ -52,8 +62,16 @@ class RoadLayout {
   const std::vector<ClusterInfo>& clusters() const { return clusters_; }
   int numMainLanes() const { return num_main_lanes_; }
   double mainlineLengthM() const { return mainline_length_m_; }
+  double clusterLengthM() const { return cluster_length_m_; }
   /// Cluster whose zone holds x (clamped to the first/last cluster).
   int clusterAt(double x_m) const;
+  /// Mainline edges in driving order (a road of the naming convention: ordered by x).
+  const std::vector<std::string>& mainline() const { return mainline_; }
+  /// true: x is measured along the lanes (xAlongMainline); false: x is SUMO's x coordinate.
+  bool measuredAlongLanes() const { return measured_along_lanes_; }
+  /// x of a vehicle at `lane_pos_m` on `edge_id` (a junction-internal edge too), measured
+  /// along the lanes; `otherwise` for an edge the road does not place.
+  double xAlongMainline(const std::string& edge_id, double lane_pos_m, double otherwise) const;
 
   /// Paper lane (1 = rightmost mainline lane .. L; 0 = not on a mainline lane) of a SUMO
   /// lane index on an edge. This is the one place where the conventions meet.
@@ -63,8 +81,14 @@ class RoadLayout {
   int sumoLaneIndex(const std::string& edge_id, int paper_lane) const;
 
  private:
+  /// Zones of cluster_length_m_ over the mainline with the ramps and merge edges of `edges_`.
+  void buildClusters(int cluster_count);
+
   std::vector<EdgeInfo> edges_;
   std::map<std::string, std::size_t> index_;
+  std::vector<std::string> mainline_;
+  std::map<std::string, double> internal_x_start_m_;
+  bool measured_along_lanes_ = false;
   std::vector<ClusterInfo> clusters_;
   int num_main_lanes_;
   double cluster_length_m_;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "palcas_sim/own_road.h"
 #include "palcas_sim/road_layout.h"
 #include "palcas_sim/road_spec.h"
 
@@ -52,6 +53,18 @@ struct ScenarioConfig {
   /// hand-written <scenario_dir>/network.{nod,edg,con}.xml are used (only road.clusters,
   /// road.num_lanes and road.cluster_length_m are then read).
   bool generate_network = true;
+  /// A user's own road, relative to scenario_dir: a SUMO network (*.net.xml, used as it is) or
+  /// a netconvert configuration (*.netccfg naming the user's sources, any edge names). The
+  /// road is found in it (own_road.h; generate_network is then not read, road.num_lanes must
+  /// be its lane count L and road.clusters splits its mainline into equal zones).
+  /// "" = generate_network decides (roads of the naming convention).
+  std::string network_file;
+  /// With network_file: the mainline's edges in driving order; empty = the discovery rule.
+  std::vector<std::string> mainline_edges;
+  /// With network_file: the user's own routes and flows (relative to scenario_dir), written
+  /// into routes.rou.xml after the vehicle types (type "mixed" is there to use) instead of
+  /// the demand of this config; "" = routes from the demand below.
+  std::string route_file;
   double penetration_rate = 0.6;     ///< CAV share PR in [0, 1] (paper default 60 %)
   unsigned int seed = 42;            ///< SUMO --seed (vehicle types, insertion, sigma)
   double duration_s = 3600.0;        ///< simulated time, SUMO --end (> 0)
@@ -119,6 +132,25 @@ VTypeProbabilities vTypeProbabilities(const ScenarioConfig& config);
 ///        not road.clusters / road.num_lanes.
 std::vector<RouteDemand> buildRoutes(const ScenarioConfig& config,
                                      const std::vector<EdgeInfo>& edges);
+
+/// What discoverOwnRoad needs from a config with network_file (mainline_edges, road.clusters).
+OwnRoadOptions ownRoadOptions(const ScenarioConfig& config);
+
+/// Routes of an own road (config.network_file) with their flows: the mainline's first edge
+/// to its last and to every off-ramp; each on-ramp to the last edge and to every off-ramp
+/// that leaves after its acceleration lane ends (or after it joins). Ids r_<from>_<to> with
+/// the zones' indices (main, on<k>; end, off<k>), edges the network's own. Route shares
+/// empty: the default rule over the ramps there are (0.55 of the mainline's traffic to the
+/// end, 0.45 over its exits; an on-ramp's 0.6 over its exits, 0.4 to the end).
+/// @throws std::invalid_argument as buildRoutes for the shares, and when the road's lane
+///         count is not road.num_lanes.
+std::vector<RouteDemand> buildOwnRoadRoutes(const ScenarioConfig& config, const OwnRoad& road);
+
+/// The network of an own road into <out_dir>/network.net.xml: a *.net.xml copied, a
+/// *.netccfg run through netconvert (its paths are relative to it). @return the path.
+/// @throws std::invalid_argument naming the file when it does not exist or is of another
+///         kind; std::runtime_error with netconvert's output when it fails.
+std::string prepareOwnNetwork(const ScenarioConfig& config, const std::string& out_dir);
 
 /// Runs netconvert on <scenario_dir>/network.{nod,edg,con}.xml into <out_dir>/network.net.xml
 /// (creating out_dir). @return the .net.xml path. @throws std::invalid_argument when a source

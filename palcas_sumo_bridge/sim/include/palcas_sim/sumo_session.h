@@ -13,6 +13,7 @@
 
 #include "palcas_core/common/action.h"
 #include "palcas_core/common/road_terms.h"
+#include "palcas_sim/own_road.h"
 #include "palcas_sim/road_layout.h"
 
 namespace palcas::sim {
@@ -25,6 +26,11 @@ struct SessionOptions {
   std::string sumo_binary = "sumo";    ///< libtraci only: "sumo" or "sumo-gui"
   int traci_port = -1;                 ///< libtraci only: -1 = let SUMO choose
   double cluster_length_m = 800.0;
+  /// A user's own road (scenario network_file): the .net.xml SUMO runs, in which the road is
+  /// found by discoverOwnRoad with own_road (cluster_length_m is then the mainline length /
+  /// own_road.clusters). "" = a road of the naming convention, read from SUMO by its names.
+  std::string own_road_net_file;
+  OwnRoadOptions own_road;
   /// true: CAVs follow advisories (RSU arms); false: SUMO drives every vehicle (SUMO-native).
   bool advisory_control = false;
   /// SUMO speed-mode bits for CAVs under advisory control (31 = SUMO keeps its safe-speed,
@@ -155,7 +161,8 @@ struct VehicleRecord {
   int lane = 0;            ///< paper lane, 0 = not on a mainline lane
   RoadPart part = RoadPart::kUnknown;
   int part_cluster = -1;   ///< cluster of the ramp / merge edge it is on, else -1
-  double x_m = 0.0;
+  double x_m = 0.0;          ///< along the mainline (RoadLayout: SUMO's x, or measured along the lanes)
+  double map_x_m = 0.0;      ///< x in SUMO's map frame (for drawing)
   double map_y_m = 0.0;      ///< y in SUMO's map frame (for drawing)
   double heading_rad = 0.0;  ///< driving direction in the map frame (from its last move), 0 = +x
   double lateral_m = 0.0;
@@ -266,6 +273,12 @@ class SumoSession {
 
  private:
   void readNetwork();
+  /// readNetwork for a road of own_road_net_file: the layout from discoverOwnRoad, the edges
+  /// the session needs from the layout's mainline order.
+  void readOwnRoad();
+  /// Entry and exit zone and route kind of a route not named r_<from>_<to> (a user's route
+  /// file), from the first on-ramp and off-ramp among its edges.
+  void classifyRouteByEdges(const std::vector<std::string>& edges, VehicleRecord* v) const;
   void onDeparted(const std::string& id);
   void readVehicles();
   void updateDerived(VehicleRecord& v) const;
