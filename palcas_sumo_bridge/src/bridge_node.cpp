@@ -91,7 +91,7 @@ void BridgeNode::publishRoad() {
   // The same road on a latched topic: a bag of the run then carries it (replay_policy).
   palcas_msgs::RoadDescription road;
   road.header.stamp = ros::Time(session().timeS());
-  road.header.frame_id = MAP_FRAME;
+  road.header.frame_id = ROAD_FRAME;
   road.zone_boundaries_m = zones;
   road.num_lanes = static_cast<std::uint8_t>(session().road().numMainLanes());
   road.step_length_s = session().stepLengthS();
@@ -163,7 +163,7 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
   clock_pub_.publish(clock);
 
   current_states_.header.stamp = stamp;
-  current_states_.header.frame_id = MAP_FRAME;
+  current_states_.header.frame_id = ROAD_FRAME;
   current_states_.step = step;
   current_states_.step_length_s = session.stepLengthS();
   current_states_.num_lanes = static_cast<uint8_t>(session.road().numMainLanes());
@@ -180,7 +180,7 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
   if (!events.empty() || runner_->lockstep().mayDecideOnOpenStep()) {
     palcas_msgs::VehicleEventArray events_msg;
     events_msg.header.stamp = stamp;
-    events_msg.header.frame_id = MAP_FRAME;
+    events_msg.header.frame_id = ROAD_FRAME;
     events_msg.step = step;
     for (const auto& e : events) events_msg.events.push_back(toMsg(e));
     events_pub_.publish(events_msg);

@@ -22,7 +22,7 @@ std_msgs::ColorRGBA rgba(float r, float g, float b, float a) {
 visualization_msgs::Marker baseMarker(const ros::Time& stamp, const std::string& ns, int id,
                                       int type) {
   visualization_msgs::Marker m;
-  m.header.frame_id = MAP_FRAME;
+  m.header.frame_id = VIEW_FRAME;  // the stretched drawing, not map (topics.h)
   m.header.stamp = stamp;
   m.ns = ns;
   m.id = id;

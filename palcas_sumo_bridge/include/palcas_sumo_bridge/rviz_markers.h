@@ -4,8 +4,8 @@
 //
 // The markers are drawn in the view's coordinates (rviz_view.h): x as in SUMO, y stretched
 // by RoadView::lateral_scale so lanes are apart on screen, and vehicles and arrows sized in
-// screen pixels (at least) rather than metres, so they show at the framing zoom. The tf
-// frames stay in true SUMO coordinates.
+// screen pixels (at least) rather than metres, so they show at the framing zoom: frame
+// "palcas_view". The tf frames stay in true SUMO coordinates: frame "map" (topics.h).
 
 #include <palcas_msgs/AdvisoryArray.h>
 #include <std_msgs/ColorRGBA.h>

@@ -16,6 +16,17 @@ constexpr char ROAD_DESCRIPTION_TOPIC[] = "road_description";  // palcas_msgs/Ro
 constexpr char REGISTER_RSU_SERVICE[] = "register_rsu";        // palcas_msgs/RegisterRsu
 constexpr char CLOCK_TOPIC[] = "/clock";                       // rosgraph_msgs/Clock
 constexpr char TF_TOPIC[] = "/tf";                             // tf2_msgs/TFMessage
+// One frame id per geometry (REP-105 for the world-fixed one):
+// - "map": SUMO's network coordinates (x, y as in the .net.xml); /tf places each vehicle
+//   (vehicle/<id>) and RSU (rsu_<k>) in it.
 constexpr char MAP_FRAME[] = "map";
+// - "palcas_road": road coordinates, not a tf frame: x along the mainline from its start
+//   (along its lanes on a curved road), lateral from the right edge of lane 1, lanes in the
+//   paper's numbering. The header of vehicle_states, vehicle_events and road_description.
+constexpr char ROAD_FRAME[] = "palcas_road";
+// - "palcas_view": the rviz drawing (rviz_view.h): x as in map, y stretched by the view's
+//   lateral scale, vehicles and arrows sized in pixels. The markers' frame and rviz's fixed
+//   frame; not on /tf (it is not a rigid transform of map), so never measure in it.
+constexpr char VIEW_FRAME[] = "palcas_view";
 
 }  // namespace palcas::bridge
