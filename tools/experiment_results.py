@@ -129,7 +129,7 @@ def aggregate(rows, arms, prs, demands):
                        and number(r.get("demand")) == demand and r["status"] == "done"]
                 jams = sorted(str(r["seed"]) for r in sel if r.get("jam") == "yes")
                 for key, _, _ in METRICS:
-                    vals = [(number(r[key]), r["seed"]) for r in sel if number(r[key]) is not None]
+                    vals = [(number(r.get(key)), r["seed"]) for r in sel if number(r.get(key)) is not None]
                     if not vals:
                         continue
                     mean, half = mean_ci95([v for v, _ in vals])

@@ -218,6 +218,28 @@ class CollectorTest(unittest.TestCase):
             experiment_results.merge(merged, [other / "results.csv", other / "results.csv"],
                                      [101, 102, 103, 104], 1800.0, "tiny")
 
+    def test_a_results_csv_from_before_a_metric_column_merges(self):
+        # An older experiment's results.csv has no throughput_vph column: its arm's cells of
+        # that metric stay empty, the other metrics are tabled.
+        experiment_results.collect(self.out, self.s, self.pts)
+        old = self.out / "old"
+        old.mkdir()
+        rows = read_csv(self.out / "results.csv")
+        fields = [k for k in rows[0].keys() if k != "throughput_vph"]
+        with open(old / "results.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+            w.writeheader()
+            for r in rows:
+                w.writerow(dict(r, point=r["point"].replace("keep", "sumo_native"), arm="sumo_native"))
+        merged = self.out / "merged_old"
+        experiment_results.merge(merged, [self.out / "results.csv", old / "results.csv"],
+                                 [101, 102, 103, 104], 1800.0, "tiny")
+        dsr = {r["arm"]: r for r in read_csv(merged / "table_dsr_pct.csv")}
+        self.assertEqual(dsr["sumo_native"]["n"], "2")
+        self.assertEqual(dsr["sumo_native"]["mean"], dsr["keep"]["mean"])
+        throughput = {r["arm"]: r for r in read_csv(merged / "table_throughput_vph.csv")}
+        self.assertEqual((throughput["sumo_native"]["n"], throughput["sumo_native"]["mean"]), ("0", ""))
+
     def test_paper_numbers_sit_beside_ours(self):
         paper = experiment_results.read_paper()
         self.assertEqual(paper[("palcas", 60.0, "dsr_pct")], (93.97, 3.56))
