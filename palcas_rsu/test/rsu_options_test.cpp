@@ -117,6 +117,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "rsu/train' has the wrong type");
   expectRefused("resume", [](ros::NodeHandle& nh) { nh.setParam("resume", true); }, "nothing to resume from");
   expectRefused("nan", [](ros::NodeHandle& nh) { nh.setParam("reward/iota", std::nan("")); }, "reward/iota");
+  expectRefused("wait", [](ros::NodeHandle& nh) { nh.setParam("decision_inputs_wait_s", -0.1); },
+                "decision_inputs_wait_s");
 }
 
 int main(int argc, char** argv) {
