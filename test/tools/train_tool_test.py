@@ -52,6 +52,26 @@ class MonitorProgress(unittest.TestCase):
     def test_no_progress_yet_gives_no_estimate(self):
         self.assertTrue(math.isnan(train_monitor.progress(0, 0, 4, 100.0, 0.0, 5.0)[1]))
 
+    def test_time_left_at_the_whole_trainings_pace(self):
+        # two episodes of 1200 s took 600 s of wall before this launch; it ran 300 s in 60 s
+        done, left = train_monitor.progress(2, 2, 4, 1200.0, 300.0, 60.0, before=(2400.0, 600.0))
+        self.assertEqual(done, 300.0)
+        self.assertAlmostEqual(left, (2 * 1200.0 - 300.0) * 660.0 / 2700.0)
+        # a launch that has not yet stepped still gets an estimate from the episodes before it
+        self.assertAlmostEqual(train_monitor.progress(2, 2, 4, 1200.0, 0.0, 1.0, before=(2400.0, 600.0))[1],
+                               2400.0 * 601.0 / 2400.0)
+
+    def test_episodes_finished_before_this_launch(self):
+        d = tempfile.mkdtemp()
+        path = os.path.join(d, "episodes.csv")
+        self.assertEqual(train_monitor.finished_before(path), (None, (0.0, 0.0)))
+        with open(path, "w") as f:
+            f.write("episode,seed,sim_seconds,wall_seconds,collision_rate_pct,dsr_pct,msr_pct\n"
+                    "0,1,1200,273.5,0,94.0,100\n1,2,1200,212.5,0.35,97.5,99.0\n")
+        last, before = train_monitor.finished_before(path)
+        self.assertEqual((last.collision_rate_pct, last.dsr_pct, last.msr_pct), (0.35, 97.5, 99.0))
+        self.assertEqual(before, (2400.0, 486.0))
+
 
 class SettleOptions(unittest.TestCase):
     def setUp(self):

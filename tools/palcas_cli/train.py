@@ -273,7 +273,8 @@ def run_launches(out, opts, record, resume, command_line):
             ["setpriv", "--pdeathsig", "TERM", sys.executable, os.path.join(str(options.ROOT), "tools", "train_monitor.py"),
              "--rsus"] + palcas_arms.rsu_ids(opts["arm"], clusters)
             + ["--episodes", str(count), "--first-episode", str(nxt), "--total-episodes", str(episodes),
-               "--duration", number_text(opts["duration"]), "--period", "15"],
+               "--duration", number_text(opts["duration"]), "--period", "15",
+               "--episodes-csv", os.path.join(out, "episodes.csv")],
             stderr=subprocess.DEVNULL, env=launch.ros_env(train_launch.port, os.path.join(out, "ros_log")))
         try:
             status = train_launch.wait()
