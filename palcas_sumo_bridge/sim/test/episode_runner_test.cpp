@@ -218,6 +218,55 @@ TEST(EpisodeRunner, ChecksAdvisoriesCarriesOutTheGoodOnesAndHoldsThem) {
 
 namespace {
 
+// One ACCELERATE for the first CAV in lane 1, then nothing (as if every later advisory were
+// lost): the steps at which it was advised and at which its command ended.
+std::pair<std::uint64_t, std::uint64_t> oneAdviceThenSilence(const std::string& name, bool channel,
+                                                             double keep_advice_s) {
+  RunnerOptions options = tinyRunner({"rsu_0"}, 30.0);
+  options.advisory_hold_steps = 10;
+  options.v2x.enabled = channel;  // latency 0, nothing lost: only the hold differs
+  options.v2x.rsu_range_m = std::numeric_limits<double>::infinity();
+  options.v2x.keep_advice_s = keep_advice_s;
+  EpisodeRunner runner(options, tinySession(name));
+  std::string reason;
+  EXPECT_TRUE(runner.lockstep().registerRsu("rsu_0", &reason));
+  std::uint64_t advised_step = 0;
+  bool advised = false;
+  ScriptedPort port(runner, [&](const SumoSession& s, EpisodeRunner& r) {
+    auto array = answer("rsu_0", s.stepCount());
+    const auto lane_one = cavsInLaneOne(s);
+    if (!advised && !lane_one.empty()) {
+      advised = true;
+      advised_step = s.stepCount();
+      advise(*array, lane_one[0], ACCELERATE, 0.5);
+    }
+    r.onAnswer(array);
+  });
+  runner.runEpisode(0, port);
+  EXPECT_TRUE(advised) << "no CAV in lane 1 within 30 s";
+  std::uint64_t ended = 0;
+  for (const auto& [step, in_force] : port.in_force_by_step)
+    if (step > advised_step && in_force == 0) {
+      ended = step;
+      break;
+    }
+  return {advised_step, ended};
+}
+
+}  // namespace
+
+TEST(EpisodeRunner, OverTheChannelACavKeepsItsLastAdviceThroughALostOne) {
+  const auto [advised, ended] = oneAdviceThenSilence("runner_keep_on", true, 1.0);
+  EXPECT_EQ(ended, advised + 20);  // 10 steps of hold + 1.0 s kept
+  const auto [advised_off, ended_off] = oneAdviceThenSilence("runner_keep_zero", true, 0.0);
+  EXPECT_EQ(ended_off, advised_off + 10);
+  // Without the channel nothing is lost: the hold ends on time whatever keep_advice_s says.
+  const auto [advised_none, ended_none] = oneAdviceThenSilence("runner_keep_nochannel", false, 1.0);
+  EXPECT_EQ(ended_none, advised_none + 10);
+}
+
+namespace {
+
 // Every CAV on the mainline advised KEEP every second for 30 s, through a channel with
 // 0.25 s latency and 30 % loss.
 EpisodeRun keepThroughChannel(const std::string& name, std::uint64_t channel_seed) {

@@ -62,6 +62,8 @@ void ChannelParams::validate() const {
   if (!std::isfinite(max_advice_age_s) || max_advice_age_s < 0.0)
     throw std::invalid_argument("v2x max_advice_age_s must be a finite value >= 0, got " +
                                 std::to_string(max_advice_age_s));
+  if (!std::isfinite(keep_advice_s) || keep_advice_s < 0.0)
+    throw std::invalid_argument("v2x keep_advice_s must be a finite value >= 0, got " + std::to_string(keep_advice_s));
   if (!std::isfinite(max_state_age_s) || max_state_age_s < 0.0)
     throw std::invalid_argument("v2x max_state_age_s must be a finite value >= 0, got " +
                                 std::to_string(max_state_age_s));

@@ -139,6 +139,9 @@ TEST(V2xChannel, BadParametersAreRefusedNamingTheField) {
   p.max_advice_age_s = -1.0;
   refused(p, "max_advice_age_s");
   p = on();
+  p.keep_advice_s = INFINITY;
+  refused(p, "keep_advice_s");
+  p = on();
   p.max_state_age_s = INFINITY;
   refused(p, "max_state_age_s");
   EXPECT_THROW(Channel(on(), 0.0), std::invalid_argument);

@@ -42,6 +42,10 @@ struct ChannelParams {
   /// singlehopRadius (a paper-road zone is 800 m: its RSU covers it and ~109 m either side).
   double rsu_range_m = 509.4;
   double max_advice_age_s = 0.5;  ///< a CAV drops an advisory older than this when it arrives [s]
+  /// A CAV keeps its last advisory this long past the bridge's hold (advisory_hold_steps)
+  /// while no newer one gets through [s]: a lost advisory leaves the last one in force instead
+  /// of handing the CAV to its own driving until the next decision. 0 = the hold ends on time.
+  double keep_advice_s = 0.0;
   double max_state_age_s = 1.0;   ///< an RSU forgets a vehicle whose last state is older [s]
   std::uint64_t seed = 0;         ///< the run's seed: same seed, same losses and delays
 
