@@ -170,7 +170,11 @@ class Launch:
         with open(self.console, mode) as console:
             self._offset = console.tell()
             self.process = subprocess.Popen(
-                ["setpriv", "--pdeathsig", "INT", "roslaunch", "-p", str(self.port)] + self.args,
+                # env --default-signal: a command started in the background by a non-interactive
+                # shell (a CI runner, `./palcas test &`) passes SIGINT on ignored, and a launch
+                # that starts with it ignored may never see the stop it carries.
+                ["env", "--default-signal=INT", "setpriv", "--pdeathsig", "INT", "roslaunch", "-p", str(self.port)]
+                + self.args,
                 stdout=console, stderr=subprocess.STDOUT, env=ros_env(self.port, self.log_dir),
                 start_new_session=True)
         with _live_lock:
