@@ -12,6 +12,7 @@ import json
 import os
 import pathlib
 import shutil
+import signal
 import stat
 import sys
 import tempfile
@@ -226,7 +227,13 @@ class LaunchRunner(unittest.TestCase):
 
     def test_sigint_reaches_the_launch_and_the_wait_says_interrupted(self):
         os.environ["FAKE_WAITS"] = "1"
-        lx = launch.Launch(["x"], self.out / "console.log", self.out / "ros_log").start()
+        # As when ./palcas was started with '&' by a non-interactive shell (a CI runner):
+        # SIGINT ignored on entry, which the launch must not inherit.
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            lx = launch.Launch(["x"], self.out / "console.log", self.out / "ros_log").start()
+        finally:
+            signal.signal(signal.SIGINT, previous)
 
         def stop_once_started():  # a loaded machine may take longer than any fixed delay
             console = self.out / "console.log"
