@@ -30,22 +30,17 @@ const RunnerOptions& checked(const RunnerOptions& o) {
   return o;
 }
 
-// Over an impaired channel a CAV keeps its last advisory past the hold until a newer one
-// gets through (v2x keep_advice_s): a lost one then leaves the pace it was given, not a gap of
-// its own car following. Every decision re-advises the CAVs of a zone, so with nothing lost
-// a newer advisory replaces the held one at the usual step. Off without the channel.
-std::uint64_t keptThroughLossSteps(const RunnerOptions& o) {
-  if (!o.v2x.enabled || !std::isfinite(o.v2x.keep_advice_s) || !(o.v2x.keep_advice_s > 0.0)) return 0;
-  return static_cast<std::uint64_t>(std::floor(o.v2x.keep_advice_s / o.step_length_s + 1e-9));
-}
-
 }  // namespace
 
 EpisodeRunner::EpisodeRunner(RunnerOptions options, SessionFactory make_session)
     : options_(checked(options)), make_session_(std::move(make_session)),
       lockstep_(options_.expected_rsus, options_.lost_after_missed_steps),
-      holds_(options_.advisory_hold_steps + keptThroughLossSteps(options_)),
-      channel_(options_.v2x, options_.step_length_s) {
+      channel_(options_.v2x, options_.step_length_s),
+      // Over an impaired channel a CAV keeps its last advisory past the hold until a newer one
+      // gets through (v2x keep_advice_s): a lost one then leaves the pace it was given, not
+      // its own car following. Every decision re-advises a zone's CAVs, so with nothing lost
+      // a newer advisory replaces the held one at the usual step.
+      holds_(options_.advisory_hold_steps + channel_.keepAdviceSteps()) {
   if (!make_session_) throw std::invalid_argument("EpisodeRunner: no session factory");
   session_ = make_session_(0);
 }

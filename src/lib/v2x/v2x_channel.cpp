@@ -102,6 +102,10 @@ std::uint64_t Channel::stepsWithin(double age_s) const {
   return static_cast<std::uint64_t>(std::floor(age_s / step_length_s_ + 1e-9));
 }
 
+std::uint64_t Channel::keepAdviceSteps() const {
+  return params_.enabled ? stepsWithin(params_.keep_advice_s) : 0;
+}
+
 UplinkView::UplinkView(const Channel& channel, std::string rsu_id, double rsu_x_m)
     : channel_(channel), rsu_id_(std::move(rsu_id)), rsu_x_m_(rsu_x_m) {
   if (!std::isfinite(rsu_x_m)) throw std::invalid_argument("UplinkView of " + rsu_id_ + ": RSU position is not finite");

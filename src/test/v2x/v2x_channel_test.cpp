@@ -53,6 +53,18 @@ TEST(V2xChannel, OffDeliversEverythingAtOnce) {
   EXPECT_TRUE(c.inRange(0.0, 1e6));
 }
 
+TEST(V2xChannel, KeepAdviceCountsInWholeStepsAndOnlyWithTheChannelOn) {
+  ChannelParams p = on();
+  p.keep_advice_s = 1.0;
+  EXPECT_EQ(Channel(p, STEP_S).keepAdviceSteps(), 10u);
+  p.keep_advice_s = 0.3;
+  EXPECT_EQ(Channel(p, STEP_S).keepAdviceSteps(), 3u);  // 0.3 / 0.1 is 2.999... in doubles
+  p.keep_advice_s = 0.25;
+  EXPECT_EQ(Channel(p, STEP_S).keepAdviceSteps(), 2u);  // a partial step is not kept
+  p.enabled = false;
+  EXPECT_EQ(Channel(p, STEP_S).keepAdviceSteps(), 0u);
+}
+
 TEST(V2xChannel, SameSeedSameFateWhateverTheOrder) {
   ChannelParams p = on();
   p.vehicle_state = {0.05, 0.3, 0.3};

@@ -163,8 +163,8 @@ class EpisodeRunner {
   SessionFactory make_session_;
   std::unique_ptr<SumoSession> session_;
   Lockstep lockstep_;
+  v2x::Channel channel_;  ///< before holds_: the hold length reads its keep_advice_s
   AdvisoryHolds holds_;
-  v2x::Channel channel_;
   v2x::DelayLine<AdviceInFlight> downlink_;
   std::vector<AdviceArrayPtr> pending_;  ///< answers for the open step, in arrival order
   std::unordered_set<std::string> late_this_step_;

@@ -78,6 +78,9 @@ class Channel {
   bool inRange(double rsu_x_m, double x_m) const;
   /// Age in steps past which a message of max age `age_s` is too old.
   std::uint64_t stepsWithin(double age_s) const;
+  /// Steps a CAV keeps its last advisory past its hold while no newer one gets through
+  /// (keep_advice_s); 0 with the channel off.
+  std::uint64_t keepAdviceSteps() const;
 
  private:
   ChannelParams params_;
