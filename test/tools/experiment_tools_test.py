@@ -27,6 +27,7 @@ import loop_cost  # noqa: E402
 import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
+import seed_ratio  # noqa: E402
 import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -511,6 +512,65 @@ class LoopCostTest(unittest.TestCase):
         with self.assertRaises(SystemExit) as e:
             list(loop_cost.rows(d))
         self.assertIn(d, str(e.exception))
+
+
+class SeedRatioTest(unittest.TestCase):
+    """tools/seed_ratio.py: per-seed ratios of one set of points to another."""
+
+    def write(self, rows):
+        d = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, d)
+        path = pathlib.Path(d) / "results.csv"
+        with open(path, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["point", "arm", "pr", "demand", "seed", "status", "efficiency_all_mps"])
+            for arm, pr, demand, seed, speed, status in rows:
+                w.writerow([f"{arm}_pr{pr}_d{demand}_s{seed}", arm, pr, demand, seed, status, speed])
+        return str(path)
+
+    def run_tool(self, argv):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            seed_ratio.main(argv)
+        return out.getvalue()
+
+    def test_an_arm_against_another_pairs_seed_pr_and_demand(self):
+        path = self.write([
+            ("palcas", 20, 1800, 101, 17.0, "done"), ("sumo_native", 20, 1800, 101, 20.0, "done"),
+            ("palcas", 20, 1800, 102, 18.0, "done"), ("sumo_native", 20, 1800, 102, 18.0, "done"),
+            ("palcas", 20, 1800, 103, 9.0, "failed"), ("sumo_native", 20, 1800, 103, 18.0, "done"),
+            ("palcas", 20, 2200, 101, 15.0, "done"), ("sumo_native", 20, 2200, 101, 12.0, "done"),
+            ("palcas", 60, 1800, 101, 21.0, "done")])  # no SUMO-native partner: left out
+        text = self.run_tool([path, "--of", "palcas", "--to", "sumo_native"])
+        self.assertIn("| 101 | 17.00 | 20.00 | 0.850 |", text)
+        self.assertIn("| 102 | 18.00 | 18.00 | 1.000 |", text)
+        self.assertNotIn("| 103 |", text)  # a failed point is not a seed
+        self.assertIn("| mean of 2 | | | 0.925 |", text)
+        self.assertIn("| worst seed | | | 0.850 |", text)
+        self.assertIn("| seeds below 0.95 | | | 1 of 2 |", text)
+        self.assertIn("| 101 | 15.00 | 12.00 | 1.250 |", text)
+        self.assertNotIn("PR 60", text)
+
+    def test_one_arm_against_itself_at_another_demand(self):
+        path = self.write([
+            ("sumo_native", 20, 1800, 101, 20.0, "done"), ("sumo_native", 20, 1801, 101, 17.0, "done"),
+            ("sumo_native", 20, 1800, 102, 17.0, "done"), ("sumo_native", 20, 1801, 102, 17.0, "done")])
+        text = self.run_tool([path, "--of", "sumo_native@1801", "--to", "sumo_native@1800"])
+        self.assertIn("sumo_native@1801 ÷ sumo_native@1800", text)
+        self.assertIn("| 101 | 17.00 | 20.00 | 0.850 |", text)
+        self.assertIn("| seeds below 0.95 | | | 1 of 2 |", text)
+        self.assertEqual(text.count("| worst seed |"), 1)  # 1800 against itself is no pair
+
+    def test_bad_input_is_named(self):
+        path = self.write([("palcas", 20, 1800, 101, 17.0, "done")])
+        for argv, words in (([path, "--of", "palcas", "--to", "sumo_native"], "no seed has both"),
+                            ([path, "--of", "palcas@fast", "--to", "sumo_native"], "'fast'"),
+                            ([path, "--of", "@1800", "--to", "sumo_native"], "names no arm"),
+                            ([path, "--of", "palcas", "--to", "sumo_native", "--metric", "nope"], "'nope'"),
+                            (["/nonexistent/results.csv", "--of", "a", "--to", "b"], "/nonexistent/results.csv")):
+            with self.assertRaises(SystemExit) as e:
+                seed_ratio.main(argv)
+            self.assertIn(words, str(e.exception))
 
 
 def main():
