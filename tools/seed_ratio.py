@@ -19,7 +19,11 @@ even when nothing systematic changed.
 import argparse
 import csv
 import math
+import pathlib
 import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+from experiment_results import number  # noqa: E402
 
 
 def side(text):
@@ -36,14 +40,6 @@ def side(text):
     if not math.isfinite(value) or value <= 0:
         raise SystemExit(f"seed_ratio: demand '{demand}' in '{text}' must be > 0")
     return arm, value
-
-
-def number(text):
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None
 
 
 def read_points(paths, metric):
