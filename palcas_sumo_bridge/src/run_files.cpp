@@ -275,6 +275,7 @@ json v2xJson(const BridgeOptions& o, const v2x::DownlinkCounts& d) {
           {"rsu_range_m", std::isfinite(c.rsu_range_m) ? json(c.rsu_range_m) : json("inf")},
           {"max_advice_age_s", c.max_advice_age_s},
           {"keep_advice_s", c.keep_advice_s},
+          {"keep_slowing_advice", c.keep_slowing_advice},
           {"advisories_sent", d.sent},
           {"advisories_delivered", d.delivered},
           {"advisories_applied_late", d.late},

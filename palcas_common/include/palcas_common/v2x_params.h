@@ -33,6 +33,7 @@ inline v2x::ChannelParams loadChannelParams(common::ParamReader& p, const std::s
   c.rsu_range_m = p.number(ns + "/rsu_range_m", d.rsu_range_m, 1e-3, std::numeric_limits<double>::infinity());
   c.max_advice_age_s = p.number(ns + "/max_advice_age_s", d.max_advice_age_s, 0.0, 3600.0);
   c.keep_advice_s = p.number(ns + "/keep_advice_s", d.keep_advice_s, 0.0, 3600.0);
+  c.keep_slowing_advice = p.get<bool>(ns + "/keep_slowing_advice", d.keep_slowing_advice);
   c.max_state_age_s = p.number(ns + "/max_state_age_s", d.max_state_age_s, 0.0, 3600.0);
   c.seed = p.count(ns + "/seed", d.seed, 0);
   try {

@@ -5,13 +5,14 @@
 
 namespace palcas::sim {
 
-AdvisoryHolds::AdvisoryHolds(std::uint64_t hold_steps) : hold_steps_(hold_steps) {
+AdvisoryHolds::AdvisoryHolds(std::uint64_t hold_steps, std::uint64_t keep_steps)
+    : hold_steps_(hold_steps), keep_steps_(keep_steps) {
   if (hold_steps < 1) throw std::invalid_argument("advisory holds: hold_steps must be >= 1, got 0");
 }
 
 void AdvisoryHolds::advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step,
-                            int action) {
-  holds_[vehicle_id] = Hold{rsu_id, step, action};
+                            int action, bool keepable) {
+  holds_[vehicle_id] = Hold{rsu_id, step, action, keepable};
 }
 
 std::vector<std::pair<std::string, int>> AdvisoryHolds::inForce() const {
@@ -31,7 +32,8 @@ std::vector<std::string> AdvisoryHolds::ending(std::uint64_t step, const std::un
       continue;
     }
     Hold& h = it->second;
-    if (h.step != step && (late_rsus.count(h.rsu_id) || step >= h.step + hold_steps_)) {
+    const std::uint64_t length = hold_steps_ + (h.keepable ? keep_steps_ : 0);
+    if (h.step != step && (late_rsus.count(h.rsu_id) || step >= h.step + length)) {
       out.push_back(it->first);
       h.action = -1;
     }

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "palcas_core/common/action.h"
+
 namespace palcas::sim {
 namespace {
 
@@ -40,7 +42,7 @@ EpisodeRunner::EpisodeRunner(RunnerOptions options, SessionFactory make_session)
       // gets through (v2x keep_advice_s): a lost one then leaves the pace it was given, not
       // its own car following. Every decision re-advises a zone's CAVs, so with nothing lost
       // a newer advisory replaces the held one at the usual step.
-      holds_(options_.advisory_hold_steps + channel_.keepAdviceSteps()) {
+      holds_(options_.advisory_hold_steps, channel_.keepAdviceSteps()) {
   if (!make_session_) throw std::invalid_argument("EpisodeRunner: no session factory");
   session_ = make_session_(0);
 }
@@ -193,7 +195,11 @@ void EpisodeRunner::actuate(EpisodePort& port) {
       continue;
     }
     advised.insert(a.vehicle_id);
-    holds_.advised(a.vehicle_id, in.array->rsu_id, step, a.action_code);
+    // A kept advisory is a guess at the one that was lost: with keep_slowing_advice off, a
+    // slowing one is not guessed on.
+    const bool slows = a.action_code == static_cast<int>(Action::kAccelerate) && a.accel_mps2 < 0.0;
+    holds_.advised(a.vehicle_id, in.array->rsu_id, step, a.action_code,
+                   channel_.params().keep_slowing_advice || !slows);
     port.applied(a.vehicle_id);
   }
   pending_.clear();

@@ -60,3 +60,14 @@ TEST(AdvisoryHolds, InForceListsHeldCommandsUntilTheyEnd) {
   holds.advised("b", "rsu_0", 111, 2);  // advised again
   EXPECT_EQ(holds.inForce(), (Pairs{{"a", 1}, {"b", 2}}));
 }
+
+TEST(AdvisoryHolds, OnlyKeepableCommandsHoldTheKeepStepsLonger) {
+  AdvisoryHolds holds(10, 5);
+  holds.advised("kept", "rsu_0", 100, 2);
+  holds.advised("not_kept", "rsu_0", 100, 2, false);
+  const auto road = onRoad({"kept", "not_kept"});
+  EXPECT_EQ(holds.ending(109, NONE_LATE, road), Ids{});
+  EXPECT_EQ(holds.ending(110, NONE_LATE, road), Ids{"not_kept"});
+  EXPECT_EQ(holds.ending(114, NONE_LATE, road), Ids{"not_kept"});
+  EXPECT_EQ(holds.ending(115, NONE_LATE, road), (Ids{"kept", "not_kept"}));
+}

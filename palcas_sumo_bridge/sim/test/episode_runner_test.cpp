@@ -221,12 +221,14 @@ namespace {
 // One ACCELERATE for the first CAV in lane 1, then nothing (as if every later advisory were
 // lost): the steps at which it was advised and at which its command ended.
 std::pair<std::uint64_t, std::uint64_t> oneAdviceThenSilence(const std::string& name, bool channel,
-                                                             double keep_advice_s) {
+                                                             double keep_advice_s, double accel_mps2 = 0.5,
+                                                             bool keep_slowing_advice = true) {
   RunnerOptions options = tinyRunner({"rsu_0"}, 30.0);
   options.advisory_hold_steps = 10;
   options.v2x.enabled = channel;  // latency 0, nothing lost: only the hold differs
   options.v2x.rsu_range_m = std::numeric_limits<double>::infinity();
   options.v2x.keep_advice_s = keep_advice_s;
+  options.v2x.keep_slowing_advice = keep_slowing_advice;
   EpisodeRunner runner(options, tinySession(name));
   std::string reason;
   EXPECT_TRUE(runner.lockstep().registerRsu("rsu_0", &reason));
@@ -238,7 +240,7 @@ std::pair<std::uint64_t, std::uint64_t> oneAdviceThenSilence(const std::string& 
     if (!advised && !lane_one.empty()) {
       advised = true;
       advised_step = s.stepCount();
-      advise(*array, lane_one[0], ACCELERATE, 0.5);
+      advise(*array, lane_one[0], ACCELERATE, accel_mps2);
     }
     r.onAnswer(array);
   });
@@ -263,6 +265,17 @@ TEST(EpisodeRunner, OverTheChannelACavKeepsItsLastAdviceThroughALostOne) {
   // Without the channel nothing is lost: the hold ends on time whatever keep_advice_s says.
   const auto [advised_none, ended_none] = oneAdviceThenSilence("runner_keep_nochannel", false, 1.0);
   EXPECT_EQ(ended_none, advised_none + 10);
+}
+
+TEST(EpisodeRunner, WithoutKeepSlowingAdviceOnlyAdviceThatDoesNotSlowIsKept) {
+  // A slowing ACCELERATE ends on time; one that does not slow is kept as before.
+  const auto [advised_slow, ended_slow] = oneAdviceThenSilence("runner_keep_slow", true, 1.0, -0.5, false);
+  EXPECT_EQ(ended_slow, advised_slow + 10);
+  const auto [advised_fast, ended_fast] = oneAdviceThenSilence("runner_keep_fast", true, 1.0, 0.5, false);
+  EXPECT_EQ(ended_fast, advised_fast + 20);
+  // keep_slowing_advice on: the slowing one is kept too.
+  const auto [advised_both, ended_both] = oneAdviceThenSilence("runner_keep_slow_on", true, 1.0, -0.5, true);
+  EXPECT_EQ(ended_both, advised_both + 20);
 }
 
 namespace {

@@ -16,15 +16,19 @@ namespace palcas::sim {
 
 class AdvisoryHolds {
  public:
+  /// `keep_steps`: how much longer a command marked keepable holds while no newer advisory
+  /// comes (over an impaired channel: v2x keep_advice_s).
   /// @throws std::invalid_argument if hold_steps < 1.
-  explicit AdvisoryHolds(std::uint64_t hold_steps);
+  explicit AdvisoryHolds(std::uint64_t hold_steps, std::uint64_t keep_steps = 0);
 
   /// `rsu_id` advised `vehicle_id` to take `action` at bridge step `step` (replaces its
-  /// previous hold).
-  void advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step, int action);
+  /// previous hold); a `keepable` one holds keep_steps longer.
+  void advised(const std::string& vehicle_id, const std::string& rsu_id, std::uint64_t step, int action,
+               bool keepable = true);
 
   /// The vehicles whose command ends at `step`: not advised at this step, and either their
-  /// hold ran out (step >= advised step + hold_steps) or their RSU is in `late_rsus`.
+  /// hold ran out (step >= advised step + hold_steps, + keep_steps if keepable) or their RSU
+  /// is in `late_rsus`.
   /// They stay known (their command is ended again at later steps until a new advisory:
   /// ending a command is idempotent in the session) until `on_road` says they left, then
   /// they are forgotten.
@@ -38,14 +42,17 @@ class AdvisoryHolds {
   void clear() { holds_.clear(); }
   std::size_t size() const { return holds_.size(); }
   std::uint64_t holdSteps() const { return hold_steps_; }
+  std::uint64_t keepSteps() const { return keep_steps_; }
 
  private:
   struct Hold {
     std::string rsu_id;
     std::uint64_t step = 0;
     int action = -1;  ///< -1 once the command ended and the CAV's own driving took over
+    bool keepable = true;
   };
   std::uint64_t hold_steps_;
+  std::uint64_t keep_steps_;
   std::unordered_map<std::string, Hold> holds_;
 };
 

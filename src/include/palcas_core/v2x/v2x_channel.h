@@ -46,6 +46,10 @@ struct ChannelParams {
   /// while no newer one gets through [s]: a lost advisory leaves the last one in force instead
   /// of handing the CAV to its own driving until the next decision. 0 = the hold ends on time.
   double keep_advice_s = 0.0;
+  /// Whether keep_advice_s also keeps an ACCELERATE below 0. false: only advice that does not
+  /// slow the CAV is kept; a lost one after a slowing advisory hands it to its own driving on
+  /// time (a kept guess must not cost speed).
+  bool keep_slowing_advice = true;
   double max_state_age_s = 1.0;   ///< an RSU forgets a vehicle whose last state is older [s]
   std::uint64_t seed = 0;         ///< the run's seed: same seed, same losses and delays
 
