@@ -33,11 +33,13 @@ wait_for() {  # SECONDS COMMAND...: poll until the command succeeds
   local end=$((SECONDS + $1)); shift
   until "$@"; do [ $SECONDS -lt $end ] || return 1; sleep 0.5; done
 }
-logged() { sed 's/\x1b\[[0-9;]*m//g' "$WORK/bridge.log" | grep -a -- "$1" >/dev/null; }
+# The bridge's log without its colour codes.
+bridge_log() { sed 's/\x1b\[[0-9;]*m//g' "$WORK/bridge.log"; }
+logged() { bridge_log | grep -a -- "$1" >/dev/null; }
 # The simulated second of the bridge's last progress line (0 before the first).
 progress() {
   local t
-  t="$(sed 's/\x1b\[[0-9;]*m//g' "$WORK/bridge.log" | grep -aoE 't= *[0-9]+/600' | tail -1 | grep -oE '[0-9]+/' | tr -d /)"
+  t="$(bridge_log | grep -aoE 't= *[0-9]+/600' | tail -1 | grep -oE '[0-9]+/' | tr -d /)"
   echo "${t:-0}"
 }
 moved_past() { [ "$(progress)" -gt "$1" ]; }
