@@ -79,7 +79,8 @@ TEST(ConfigFiles, TheV2xChannelIsOffUnlessAFileTurnsItOn) {
   EXPECT_DOUBLE_EQ(o.v2x.cluster_state.latency_s, 0.3);
   EXPECT_DOUBLE_EQ(o.v2x.rsu_range_m, 509.4);  // MOSAIC SNS's default single-hop radius
   EXPECT_DOUBLE_EQ(o.v2x.max_advice_age_s, 0.5);
-  EXPECT_DOUBLE_EQ(o.v2x.keep_advice_s, 0.0);
+  EXPECT_DOUBLE_EQ(o.v2x.keep_advice_s, 1.0);
+  EXPECT_FALSE(o.v2x.keep_slowing_advice);
   EXPECT_EQ(o.v2x.seed, 104u);
   // A loss probability of 1.
   palcas_test::expectThrowNaming<std::invalid_argument>(
