@@ -126,6 +126,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.guard_busy_leave_share =
       p.number("guard_busy_leave_share", o.session.guard_busy_leave_share, 0.0, 1.0);
   o.session.guard_busy_window_s = p.number("guard_busy_window_s", o.session.guard_busy_window_s, 0.1, 3600.0);
+  o.session.guard_busy_at_start = p.get<bool>("guard_busy_at_start", o.session.guard_busy_at_start);
   o.session.guard_busy_floor_speed_share =
       p.number("guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share, 0.0, 1.0);
   o.session.guard_busy_handback = p.get<bool>("guard_busy_handback", o.session.guard_busy_handback);

@@ -16,8 +16,10 @@ void SumoSession::updateZones() {
   if (options_.guard_busy_speed_share <= 0.0) return;
   const std::size_t n = road_->clusters().size();
   if (zone_speed_share_.size() != n) {
-    zone_speed_share_.assign(n, 1.0);  // an empty road is free
-    zone_busy_.assign(n, false);
+    // An empty road runs free; or (guard_busy_at_start) a zone is taken as stopped until its
+    // smoothed share has risen above the leave share: a window or two of free running.
+    zone_speed_share_.assign(n, options_.guard_busy_at_start ? 0.0 : 1.0);
+    zone_busy_.assign(n, options_.guard_busy_at_start);
   }
   std::vector<double> sum(n, 0.0);
   std::vector<int> count(n, 0);

@@ -93,6 +93,11 @@ struct SessionOptions {
   double guard_busy_speed_share = 0.8;
   double guard_busy_leave_share = 0.88;
   double guard_busy_window_s = 30.0;
+  /// true: a zone counts as busy from the start until its smoothed speed share, starting from
+  /// 0, has risen above guard_busy_leave_share (a window or two of free running: advice starts
+  /// where the road has shown it runs free); false: an empty zone starts free, and the first
+  /// minute of a road filling near capacity is advised.
+  bool guard_busy_at_start = false;
   /// The floor's share in a busy zone (1 = advice slows nobody there: its CAVs drive
   /// themselves; guard_floor_speed_share elsewhere).
   double guard_busy_floor_speed_share = 1.0;
