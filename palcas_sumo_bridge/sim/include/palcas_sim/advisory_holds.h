@@ -42,7 +42,6 @@ class AdvisoryHolds {
   void clear() { holds_.clear(); }
   std::size_t size() const { return holds_.size(); }
   std::uint64_t holdSteps() const { return hold_steps_; }
-  std::uint64_t keepSteps() const { return keep_steps_; }
 
  private:
   struct Hold {
