@@ -4,8 +4,9 @@
 
 namespace palcas::rsu {
 
-DecisionInputs::DecisionInputs(int own_cluster, int zone_count, bool i2i, std::uint64_t decision_period_steps)
-    : period_(decision_period_steps) {
+DecisionInputs::DecisionInputs(int own_cluster, int zone_count, bool i2i, std::uint64_t decision_period_steps,
+                               bool events)
+    : period_(decision_period_steps), events_(events) {
   if (own_cluster < 0 || zone_count < 1 || own_cluster >= zone_count)
     throw std::invalid_argument("DecisionInputs: cluster " + std::to_string(own_cluster) + " is not one of " +
                                 std::to_string(zone_count) + " zone(s)");
@@ -41,7 +42,7 @@ std::vector<std::string> DecisionInputs::missing(std::uint64_t step) const {
   // The array of `step` or a later one of the same round (the bridge went on without this
   // RSU's answer); arrays arrive in order, so the earlier ones are in. A far larger step is
   // the last episode's.
-  if (!events_step_ || *events_step_ < step || *events_step_ >= step + period_)
+  if (events_ && (!events_step_ || *events_step_ < step || *events_step_ >= step + period_))
     out.push_back("events of step " + std::to_string(step));
   for (int k : neighbours_)
     if (neighbourDue(k, step))

@@ -15,7 +15,6 @@
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/ClusterState.h>
 #include <palcas_msgs/RoadDescription.h>
-#include <palcas_msgs/VehicleEventArray.h>
 #include <palcas_msgs/VehicleStateArray.h>
 #include <ros/master.h>
 #include <ros/ros.h>
@@ -48,7 +47,6 @@ using palcas::rsu::RsuNodeOptions;
 namespace {
 
 constexpr char STATES_TOPIC[] = "/vehicle_states";
-constexpr char EVENTS_TOPIC[] = "/vehicle_events";
 constexpr char ADVISORIES_TOPIC[] = "/advisories";
 constexpr char CLUSTER_TOPIC[] = "/cluster_states";
 constexpr char ROAD_TOPIC[] = "/road_description";
@@ -238,7 +236,6 @@ struct ReplayedRsu {
   RsuNodeOptions options;
   std::unique_ptr<RsuController> controller;
   std::unique_ptr<palcas::rsu::PeerStates> peers;
-  palcas::rsu::VehicleOutcomes outcomes;
   double last_own_density = std::numeric_limits<double>::quiet_NaN();
   // The V2X channel's uplink as the live RSU had it (options.v2x.enabled): fed every
   // recorded step, so a decision sees the same stale and missing states.
@@ -395,15 +392,6 @@ int run(const Args& args) {
   std::size_t next_cluster_state = 0;
   std::uint64_t i2i_delivered_otherwise = 0;  // decisions whose live peer states differ from the bag's order
 
-  // Events by step, not by bag time: the recorder's queue may write a step's states after
-  // later steps' events. The live RSU decides on step k's states before step k's events
-  // (published after them), so a decision at step k sees the events of steps before k.
-  std::vector<palcas_msgs::VehicleEventArray> events;
-  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(EVENTS_TOPIC)))
-    if (auto e = m.instantiate<palcas_msgs::VehicleEventArray>()) events.push_back(*e);
-  std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.step < b.step; });
-  std::size_t next_event = 0;
-
   std::optional<std::uint64_t> previous_step;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC))) {
     const auto states = m.instantiate<palcas_msgs::VehicleStateArray>();
@@ -427,10 +415,6 @@ int run(const Args& args) {
     if (states->step % static_cast<std::uint64_t>(period) != 0) continue;
     ++decision_steps;
     const double now_s = states->header.stamp.toSec();
-    while (next_event < events.size() && events[next_event].step < states->step) {
-      for (ReplayedRsu& r : rsus) palcas::rsu::addOutcomes(events[next_event], r.outcomes);
-      ++next_event;
-    }
     // Peers' statistics up to (not including) this decision's time; PeerStates itself also
     // ignores those of the same step, as the live RSU does.
     while (next_cluster_state < cluster_states.size() &&
@@ -466,11 +450,9 @@ int run(const Args& args) {
         const auto h = heard.find(r.id);
         if (r.uplink && h == heard.end()) throw std::invalid_argument("malformed state");
         const palcas::RoadSnapshot& seen = r.uplink ? h->second : snapshot;
-        // As RsuNode: over the channel, an evaluating RSU decides without the removal events.
+        // As RsuNode: an evaluating RSU decides on the states alone, without the removal events.
         const palcas::rsu::VehicleOutcomes none;
-        const palcas::rsu::DecisionOutput d =
-            r.controller->advise(seen, states->step, now_s, global, r.uplink ? none : r.outcomes);
-        r.outcomes.clear();
+        const palcas::rsu::DecisionOutput d = r.controller->advise(seen, states->step, now_s, global, none);
         r.last_own_density = d.cluster.density_veh_per_km;
         for (const auto& a : d.advisories) {
           const palcas_msgs::Advisory msg = palcas::rsu::toMsg(a, d.model_version);

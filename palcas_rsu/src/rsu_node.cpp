@@ -68,12 +68,12 @@ RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHa
   return o;
 }
 
-/// The decision inputs to wait for: the step's events, and with I2I between zones the
-/// neighbours' cluster states (the whole-road RSU has no neighbour).
+/// The decision inputs to wait for: training, the step's events, and with I2I between zones
+/// the neighbours' cluster states (the whole-road RSU has no neighbour).
 DecisionInputs decisionInputsOf(const RsuNodeOptions& o) {
   const int zones = std::max(static_cast<int>(o.zones_m.size()) - 1, o.controller.cluster_index + 1);
   return DecisionInputs(o.controller.cluster_index, zones, o.i2i && !o.whole_road,
-                        static_cast<std::uint64_t>(o.decision_period_steps));
+                        static_cast<std::uint64_t>(o.decision_period_steps), o.controller.train);
 }
 
 }  // namespace
@@ -235,7 +235,7 @@ void RsuNode::registerWithBridge() {
 }
 
 void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) {
-  addOutcomes(*msg, outcomes_);
+  if (options_.controller.train) addOutcomes(*msg, outcomes_);  // evaluating, unused (advise)
   inputs_.eventsArrived(msg->step);
   decideHeldIfReady();
 }
@@ -405,11 +405,13 @@ DecisionOutput RsuNode::advise(const palcas_msgs::VehicleStateArray& msg, double
   // densities as given, so use the peers' view with the last own density.
   const double unknown = std::numeric_limits<double>::quiet_NaN();
   global = options_.i2i ? peers_.global(last_own_density_, now_s) : GlobalDensities{unknown, unknown, unknown};
-  // Evaluating over the V2X channel, membership comes from what reached the RSU alone: the
-  // bridge's removal events race the states over ROS and would decide a stale vehicle's
-  // membership by arrival order. Training keeps them (its terminal rewards).
+  // Evaluating, membership comes from the states alone, so a decision need not wait for its
+  // step's events (DecisionInputs): the bridge drops a removed vehicle from the states of the
+  // step that removes it, and over the V2X channel the events would race the delayed states
+  // and decide a stale vehicle's membership by arrival order. Training keeps them: they close
+  // its transitions with their terminal rewards.
   const VehicleOutcomes none;
-  DecisionOutput decision = controller_->advise(snapshot, msg.step, now_s, global, uplink_ && !c.train ? none : outcomes_);
+  DecisionOutput decision = controller_->advise(snapshot, msg.step, now_s, global, c.train ? outcomes_ : none);
   outcomes_.clear();
   last_own_density_ = decision.cluster.density_veh_per_km;
   return decision;

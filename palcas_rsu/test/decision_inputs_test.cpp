@@ -108,3 +108,17 @@ TEST(DecisionInputs, RefusesABadZoneOrPeriod) {
   expectThrowNaming<std::invalid_argument>([] { DecisionInputs(-1, 3, true, PERIOD); }, "cluster -1");
   expectThrowNaming<std::invalid_argument>([] { DecisionInputs(0, 3, true, 0); }, "decision_period_steps");
 }
+
+TEST(DecisionInputs, AnEvaluatingRsuDoesNotWaitForEvents) {
+  // Evaluating, a decision uses no events (RsuNode::advise), so none is waited for; the
+  // neighbours of the previous round still are.
+  DecisionInputs in(1, 3, true, PERIOD, false);
+  EXPECT_TRUE(in.ready(0));
+  EXPECT_EQ(in.missing(20), (std::vector<std::string>{"cluster state of cluster 0 for step 10",
+                                                       "cluster state of cluster 2 for step 10"}));
+  in.clusterStateArrived(0, 10);
+  in.clusterStateArrived(2, 10);
+  EXPECT_TRUE(in.ready(20));
+  in.eventsArrived(20);  // still taken, changes nothing
+  EXPECT_TRUE(in.ready(20));
+}

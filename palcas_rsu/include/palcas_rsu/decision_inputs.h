@@ -4,9 +4,12 @@
 // two decisions states, vehicle events and the peers' cluster states stream in over separate
 // connections, in no fixed order against each other. A decision at step s is taken only
 // once this RSU holds
-//   - the bridge's events of step s (the bridge publishes an event array, empty too, before
-//     the states of every step an RSU is due on; on one topic they arrive in order, so the
-//     arrays of earlier steps with events are in too), and
+//   - when it trains, the bridge's events of step s (the bridge publishes an event array,
+//     empty too, before the states of every step an RSU is due on; on one topic they arrive
+//     in order, so the arrays of earlier steps with events are in too). The events close
+//     transitions with their terminal rewards; an evaluating RSU decides on the states alone
+//     (the bridge removes a vehicle from the states of the step that removes it, so the
+//     events change no membership), and waiting for them cost it ~1 ms a decision, and
 //   - each neighbour's cluster state of the previous decision round (stamped at or after
 //     s - period: the newest a decision at s may use, PeerStates::global),
 // so that the same seed gives the same decisions however the messages interleave. A
@@ -28,9 +31,12 @@ class DecisionInputs {
   /// @param own_cluster this RSU's cluster index (>= 0) among `zone_count` zones;
   /// @param i2i whether the RSU uses its neighbours' cluster states at all (false: no wait for
   ///        them, e.g. I2I off or the centralized whole-road RSU);
-  /// @param decision_period_steps >= 1, the same for every RSU of the road.
+  /// @param decision_period_steps >= 1, the same for every RSU of the road;
+  /// @param events whether a decision waits for its step's vehicle events (a training RSU:
+  ///        they close its transitions; an evaluating one does not use them).
   /// @throws std::invalid_argument naming the bad value.
-  DecisionInputs(int own_cluster, int zone_count, bool i2i, std::uint64_t decision_period_steps);
+  DecisionInputs(int own_cluster, int zone_count, bool i2i, std::uint64_t decision_period_steps,
+                 bool events = true);
 
   /// The bridge's event array of `step` arrived (possibly empty).
   void eventsArrived(std::uint64_t step);
@@ -52,6 +58,7 @@ class DecisionInputs {
   bool neighbourDue(int cluster, std::uint64_t step) const;
 
   std::uint64_t period_;
+  bool events_;
   std::vector<int> neighbours_;
   std::optional<std::uint64_t> events_step_;          ///< step of the newest event array
   std::map<int, std::uint64_t> cluster_step_;         ///< newest cluster state per neighbour
