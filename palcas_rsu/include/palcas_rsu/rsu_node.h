@@ -2,8 +2,8 @@
 // The RSU node: a thin ROS shell around palcas_core's RsuController. It registers with the
 // bridge at its decision period and answers the lockstep on its decision steps only (an
 // unregistered RSU answers every step, empty between decisions); at the decision steps
-// of its RsuSchedule, once its step's events and its neighbours' cluster states are in
-// (DecisionInputs), it converts the state, calls the controller once for all its CAVs,
+// of its RsuSchedule, once its neighbours' cluster states (and, training, its step's events)
+// are in (DecisionInputs), it converts the state, calls the controller once for all its CAVs,
 // publishes the advisories, its ClusterState (I2I) and its RsuStatus, then does what the
 // schedule says follows (learning, the federation client's tick, checkpoints).
 
