@@ -235,7 +235,7 @@ void RsuNode::registerWithBridge() {
 }
 
 void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) {
-  if (options_.controller.train) addOutcomes(*msg, outcomes_);  // evaluating, unused (advise)
+  addOutcomes(*msg, outcomes_);
   inputs_.eventsArrived(msg->step);
   decideHeldIfReady();
 }
