@@ -130,6 +130,8 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.guard_busy_floor_speed_share =
       p.number("guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share, 0.0, 1.0);
   o.session.guard_busy_handback = p.get<bool>("guard_busy_handback", o.session.guard_busy_handback);
+  o.session.guard_busy_lc_assertive =
+      p.number("guard_busy_lc_assertive", o.session.guard_busy_lc_assertive, 0.0, 100.0);
   o.session.guard_insertion_edge = p.get<bool>("guard_insertion_edge", o.session.guard_insertion_edge);
   o.session.assist_mode = p.get<bool>("assist_mode", o.session.assist_mode);
   o.session.assist_lane_change_mode =

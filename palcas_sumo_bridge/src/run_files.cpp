@@ -123,6 +123,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"guard_busy_at_start", o.session.guard_busy_at_start},
           {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
           {"guard_busy_handback", o.session.guard_busy_handback},
+          {"guard_busy_lc_assertive", o.session.guard_busy_lc_assertive},
           {"guard_insertion_edge", o.session.guard_insertion_edge},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
@@ -260,6 +261,7 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"handbacks", g.handbacks},
           {"handback_cav_s", dt * g.handback_steps},
           {"handback_advice_dropped", g.handback_advice_dropped},
+          {"busy_lc_assertive", o.session.guard_busy_lc_assertive},
           {"insertion_edge", o.session.guard_insertion_edge},
           {"lane_changes_insertion_refused", g.lane_changes_insertion_refused}};
 }

@@ -34,7 +34,7 @@ from junit_runner import run_as_junit  # noqa: E402
 
 def args(**kw):
     base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
-                policy=None, jobs=1, demands=None, v2x="")
+                policy=None, jobs=1, demands=None, v2x="", bridge_params="")
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -127,16 +127,22 @@ class PlannerTest(unittest.TestCase):
         merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(demands="1800,1400")))
         self.assertEqual(merged["demands"], [1400.0, 1800.0])
 
-    def test_a_channel_is_part_of_the_settings(self):
-        with self.assertRaises(experiment.UsageError) as e:
-            experiment.settings_from_args(args(v2x="/no/such/v2x.yaml"))
-        self.assertIn("--v2x /no/such/v2x.yaml: no such file", str(e.exception))
-        experiment.save_settings(self.out, experiment.settings_from_args(args()))
-        channel = self.out / "v2x.yaml"
-        channel.write_text("v2x: {enabled: true}\n")
-        with self.assertRaises(experiment.UsageError) as e:
-            experiment.merge_settings(self.out, experiment.settings_from_args(args(v2x=str(channel))))
-        self.assertIn("v2x", str(e.exception))
+    def test_a_channel_or_bridge_override_is_part_of_the_settings(self):
+        cases = (("v2x", "--v2x", "v2x: {enabled: true}\n"),
+                 ("bridge_params", "--bridge-params", "guard_busy_lc_assertive: 2.0\n"))
+        for key, option, content in cases:
+            with self.subTest(option=option):
+                with self.assertRaises(experiment.UsageError) as e:
+                    experiment.settings_from_args(args(**{key: "/no/such/file.yaml"}))
+                self.assertIn(f"{option} /no/such/file.yaml: no such file", str(e.exception))
+                experiment.save_settings(self.out, experiment.settings_from_args(args()))
+                given = self.out / f"{key}.yaml"
+                given.write_text(content)
+                with_file = experiment.settings_from_args(args(**{key: str(given)}))
+                self.assertEqual(with_file[key], str(given.resolve()))
+                with self.assertRaises(experiment.UsageError) as e:
+                    experiment.merge_settings(self.out, with_file)
+                self.assertIn(key, str(e.exception))
 
     def test_continuation_extends_but_never_changes_duration(self):
         s = experiment.settings_from_args(args())

@@ -39,7 +39,9 @@ from palcas_arms import ALL_ARMS, LEARNING_ARMS
 PAPER_PRS = (5, 10, 20, 40, 60)
 FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.
-FIXED_KEYS = ("duration_s", "scenario", "v2x")
+FIXED_KEYS = ("duration_s", "scenario", "v2x", "bridge_params")
+# Files every point runs with: settings key, ./palcas run option.
+POINT_FILES = (("v2x", "--v2x"), ("bridge_params", "--bridge-params"))
 
 
 class UsageError(OptionError):
@@ -124,11 +126,11 @@ def settings_from_args(a):
                 "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
     if demands is not None:
         settings["demands"] = demands
-    settings["v2x"] = ""
-    if a.v2x:
-        if not os.path.isfile(a.v2x):
-            raise UsageError(f"--v2x {a.v2x}: no such file")
-        settings["v2x"] = os.path.abspath(a.v2x)
+    for key, option in POINT_FILES:
+        path = getattr(a, key, "") or ""
+        if path and not os.path.isfile(path):
+            raise UsageError(f"{option} {path}: no such file")
+        settings[key] = os.path.abspath(path) if path else ""
     return settings
 
 
@@ -139,7 +141,8 @@ def merge_settings(out, wanted):
     if not f.exists():
         return wanted
     have = json.loads(f.read_text())
-    have.setdefault("v2x", "")  # an experiment from before the channel ran without it
+    for key, _ in POINT_FILES:  # an experiment from before these options ran without them
+        have.setdefault(key, "")
     for key in FIXED_KEYS:
         if have[key] != wanted[key]:
             raise UsageError(f"{out} holds an experiment with {key} = {have[key]}, not "
@@ -243,8 +246,9 @@ def run_point(out, name):
         argv += ["--policy", settings["policies"][p["arm"]]]
     if not p["trajectories"]:
         argv += ["--no-trajectories"]
-    if settings.get("v2x"):
-        argv += ["--v2x", settings["v2x"]]
+    for key, option in POINT_FILES:
+        if settings.get(key):
+            argv += [option, settings[key]]
     start = time.time()
     with open(d / "point.log", "w") as log:
         point_console = Console(out=log, err=log)
@@ -362,6 +366,8 @@ def common_options(p):
     p.add_argument("--duration", type=float, default=1800.0)
     p.add_argument("--scenario", default="paper")
     p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
+    p.add_argument("--bridge-params", dest="bridge_params", default="", metavar="FILE",
+                   help="a bridge parameter override for every point (./palcas run --bridge-params)")
     p.add_argument("--policy", action="append", metavar="ARM=DIR")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
 

@@ -66,6 +66,7 @@ void SumoSession::updateHandback(VehicleRecord& v) {
   if (busy_here == v.handed_back) return;
   if (options_.assist_mode) {  // it drives itself already: only its advice is dropped
     v.handed_back = busy_here;
+    setBusyGapAcceptance(v, busy_here);
     if (busy_here) ++guard_.handbacks;
     return;
   }
@@ -74,6 +75,7 @@ void SumoSession::updateHandback(VehicleRecord& v) {
     if (v.exit_cluster >= 0 && !v.exit_committed && std::isfinite(v.distance_to_exit_m) && !routeToOwnExit(v))
       return;
     api::Vehicle::setLaneChangeMode(v.id, options_.assist_lane_change_mode);
+    setBusyGapAcceptance(v, true);
     v.command = HeldCommand::kNone;  // released in applyHeldCommand
     v.handed_back = true;
     ++guard_.handbacks;
@@ -81,6 +83,7 @@ void SumoSession::updateHandback(VehicleRecord& v) {
   }
   // Its zone is free again: lane changes (its exit included) are the RSUs' job once more.
   api::Vehicle::setLaneChangeMode(v.id, options_.cav_lane_change_mode);
+  setBusyGapAcceptance(v, false);
   v.handed_back = false;
   if (v.exit_cluster >= 0 && !end_edge_.empty() && std::isfinite(v.distance_to_exit_m)) {
     try {
@@ -89,6 +92,17 @@ void SumoSession::updateHandback(VehicleRecord& v) {
       ++route_changes_failed_;  // keeps its route to its exit
     }
     v.exit_committed = false;  // manageExit re-commits it in lane 1 before its off-ramp
+  }
+}
+
+void SumoSession::setBusyGapAcceptance(VehicleRecord& v, bool busy) const {
+  static const char* const kKey = "laneChangeModel.lcAssertive";
+  if (busy && options_.guard_busy_lc_assertive > 0.0) {
+    if (v.own_lc_assertive.empty()) v.own_lc_assertive = api::Vehicle::getParameter(v.id, kKey);
+    api::Vehicle::setParameter(v.id, kKey, std::to_string(options_.guard_busy_lc_assertive));
+  } else if (!busy && !v.own_lc_assertive.empty()) {
+    api::Vehicle::setParameter(v.id, kKey, v.own_lc_assertive);
+    v.own_lc_assertive.clear();
   }
 }
 

@@ -3,6 +3,7 @@
 // that costs up to 30 % of the road's speed (README "Advice that does no harm"). In a busy
 // zone a CAV therefore gets its own route-aware driving back (route to its off-ramp, SUMO's
 // lane changes) and its advice is dropped; once the zone is free the RSUs have it again.
+// With guard_busy_lc_assertive its gap acceptance is the busy zone's meanwhile.
 // One libsumo simulation per process: one test.
 #include <gtest/gtest.h>
 #include <libsumo/libsumo.h>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "palcas_sim/sumo_session.h"
 #include "scenario_test_util.h"
@@ -22,6 +24,11 @@ using palcas::sim::VehicleRecord;
 namespace {
 constexpr int LANE_LEFT = 0, ACCELERATE = 2;
 constexpr int OWN_LANE_CHANGE_MODE = 1621, ADVISED_LANE_CHANGE_MODE = 1536;
+constexpr double BUSY_LC_ASSERTIVE = 2.0;
+
+double lcAssertive(const std::string& id) {
+  return std::stod(libsumo::Vehicle::getParameter(id, "laneChangeModel.lcAssertive"));
+}
 
 bool inZone0(const VehicleRecord& v) {
   return v.part == RoadPart::kMainline && v.lane >= 1 && v.x_m > 5.0 && v.x_m < 295.0;
@@ -42,6 +49,9 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   options.guard_busy_window_s = 1.0;
   options.guard_busy_handback = true;
   options.assist_lane_change_mode = OWN_LANE_CHANGE_MODE;
+  options.guard_busy_lc_assertive = BUSY_LC_ASSERTIVE;
+  // Advice that runs again at the end may pick any zone-0 CAV, on the warm-up edge too.
+  options.guard_insertion_edge = false;
   SumoSession session(options);
   for (int i = 0; i < 600; ++i) session.step();  // the road fills
 
@@ -49,6 +59,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   for (const VehicleRecord& v : session.vehicles()) {
     EXPECT_FALSE(v.handed_back) << v.id << " handed back on a free road";
     if (inZone0(v) && !v.merge_mode) { EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE); }
+    if (v.is_cav) { EXPECT_DOUBLE_EQ(lcAssertive(v.id), 1.0) << v.id << ": its vType's gap acceptance"; }
   }
   EXPECT_EQ(session.guardCounters().handbacks, 0u);
 
@@ -71,6 +82,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
     if (!v.handed_back) continue;
     ++handed_back;
     EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), OWN_LANE_CHANGE_MODE) << v.id;
+    EXPECT_DOUBLE_EQ(lcAssertive(v.id), BUSY_LC_ASSERTIVE) << v.id << ": the busy zone's gap acceptance";
     if (std::isfinite(v.distance_to_exit_m)) {
       ++exiting_handed_back;
       EXPECT_TRUE(routedToOwnExit(v)) << v.id << " is not routed to its off-ramp";
@@ -106,6 +118,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
     if (!inZone0(v) || v.merge_mode) continue;
     EXPECT_FALSE(v.handed_back) << v.id;
     EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE) << v.id;
+    EXPECT_DOUBLE_EQ(lcAssertive(v.id), 1.0) << v.id << ": its own gap acceptance back";
     if (std::isfinite(v.distance_to_exit_m) && !v.exit_committed) {
       EXPECT_FALSE(routedToOwnExit(v)) << v.id << " still routed to its off-ramp by SUMO";
       ++back;

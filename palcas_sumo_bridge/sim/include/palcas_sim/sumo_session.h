@@ -109,6 +109,13 @@ struct SessionOptions {
   /// advice alone cannot match there. In assist mode it only drops their advice (they drive
   /// themselves already). false: a busy zone only refuses weaving (guard_busy_speed_share).
   bool guard_busy_handback = true;
+  /// SUMO's lcAssertive for a CAV in a busy zone that makes its own lane changes (handed back,
+  /// or in assist mode): SL2015 divides the front and rear gaps a change needs by it (its
+  /// default 1). The RSU sees every vehicle around the CAV, so in a busy zone it can clear the
+  /// CAV for a gap its own sensors would not take: merges and exit changes into dense lanes
+  /// happen sooner instead of queueing. Its own value comes back when the zone is free.
+  /// 0 = off (the vType's value everywhere).
+  double guard_busy_lc_assertive = 0.0;
   /// The advice guard where traffic is inserted: no advised lane change is carried out on the
   /// mainline edge where SUMO inserts the mainline's vehicles (the warm-up edge); the CAV keeps
   /// its lane and drives itself, as under KEEP. SUMO 1.15 inserts a vehicle (departPos
@@ -186,6 +193,7 @@ struct VehicleRecord {
   bool speed_overridden = false; ///< a setSpeed of ours is in force (else SUMO's own model)
   bool merge_mode = false;       ///< strategic lane changes allowed (own_merge, accel lane)
   bool handed_back = false;      ///< busy zone: its own route-aware driving, advice dropped
+  std::string own_lc_assertive;  ///< its lcAssertive before a busy zone changed it (empty: unchanged)
   /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
   /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
   /// differ (a merge edge), until the target lane is reached or the time is up.
@@ -302,6 +310,9 @@ class SumoSession {
   /// guard_busy_handback: hands a CAV in a busy zone back to its own route-aware driving,
   /// and takes it back once its zone is free.
   void updateHandback(VehicleRecord& v);
+  /// guard_busy_lc_assertive: a busy zone's gap acceptance for a CAV making its own changes,
+  /// or its own value back (busy false).
+  void setBusyGapAcceptance(VehicleRecord& v, bool busy) const;
   /// Sets a CAV's route to the rest of its own (to its off-ramp); false when it is not on it.
   bool routeToOwnExit(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
