@@ -28,6 +28,7 @@ import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
 import seed_ratio  # noqa: E402
+import ratio_by_demand  # noqa: E402
 import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -576,6 +577,38 @@ class SeedRatioTest(unittest.TestCase):
                             (["/nonexistent/results.csv", "--of", "a", "--to", "b"], "/nonexistent/results.csv")):
             with self.assertRaises(SystemExit) as e:
                 seed_ratio.main(argv)
+            self.assertIn(words, str(e.exception))
+
+
+class RatioByDemandTest(unittest.TestCase):
+    """tools/ratio_by_demand.py: the ratio to SUMO-native on the same seed, against demand."""
+
+    write = SeedRatioTest.write  # results.csv rows of (arm, pr, demand, seed, speed, status)
+
+    def test_settings_pair_with_native_by_pr_demand_and_seed(self):
+        native = self.write([("sumo_native", 60, 1400, 101, 20.0, "done"), ("sumo_native", 60, 1400, 102, 25.0, "done"),
+                             ("sumo_native", 60, 2200, 101, 16.0, "done")])
+        runs = self.write([("palcas", 60, 1400, 101, 19.0, "done"), ("palcas", 60, 1400, 102, 25.0, "done"),
+                           ("palcas", 60, 2200, 101, 17.6, "done"), ("palcas", 60, 2200, 102, 9.0, "done"),
+                           ("palcas", 60, 1800, 101, 5.0, "failed")])
+        png = pathlib.Path(tempfile.mkdtemp()) / "ratio.png"
+        self.addCleanup(shutil.rmtree, png.parent)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            ratio_by_demand.main(["--out", str(png), "--native", native, f"with={runs}"])
+        text = out.getvalue()
+        self.assertIn("with,palcas,60,1400,2,0.9750,0.9500,1.0000", text)
+        self.assertIn("with,palcas,60,2200,1,1.1000,1.1000,1.1000", text)  # seed 102 has no native row
+        self.assertNotIn(",1800,", text)  # a failed point is not a seed
+        self.assertGreater(png.stat().st_size, 0)
+
+    def test_nothing_to_pair_is_named(self):
+        native = self.write([("sumo_native", 60, 1400, 101, 20.0, "done")])
+        runs = self.write([("palcas", 20, 1400, 101, 19.0, "done")])
+        for argv, words in ((["--out", "/tmp/x.png", "--native", native, f"with={runs}"], "no point has a SUMO-native row"),
+                            (["--out", "/tmp/x.png", "--native", native, runs], "is not LABEL=CSV")):
+            with self.assertRaises(SystemExit) as e:
+                ratio_by_demand.main(argv)
             self.assertIn(words, str(e.exception))
 
 
