@@ -6,8 +6,9 @@ usage: ratio_by_demand.py --out PNG --native CSV [--native CSV ...] LABEL=CSV[,C
 Every LABEL=CSV list is a setting (e.g. "with the option", "without"); its ./palcas experiment
 results.csv rows (any arm but sumo_native) are paired with the sumo_native row of the same PR,
 demand and seed from the --native CSVs. A line per (setting, arm) gives the mean ratio over
-the seeds at each demand, the bar its worst and best seed. Dashed lines at 1 (SUMO-native)
-and 0.95 / 1.05 (issue 18's worst-seed and capacity bounds). Also prints the points as CSV.
+the seeds at each demand, the bar its worst and best seed; the first setting's lines are
+solid, the next dotted. Grey lines at 1 (SUMO-native) and, dashed, 0.95 / 1.05 (issue 18's
+worst-seed and capacity bounds). Also prints the points as CSV.
 """
 import argparse
 import csv
@@ -38,8 +39,10 @@ def main(argv=None):
     native = {key(r): float(r["efficiency_all_mps"]) for path in a.native for r in rows(path)
               if r["arm"] == "sumo_native"}
     ratios = defaultdict(list)  # (label, arm, pr, demand) -> [ratio]
+    line_style = {}  # a setting's line: the first solid, the next dotted, dashed, ...
     for setting in a.settings:
         label, _, paths = setting.partition("=")
+        line_style[label] = ("-", ":", "--", "-.")[len(line_style) % 4]
         if not paths:
             sys.exit(f"ratio_by_demand: '{setting}' is not LABEL=CSV")
         for path in paths.split(","):
@@ -62,7 +65,7 @@ def main(argv=None):
             low = [m - min(v) for m, (_, v) in zip(means, pts)]
             high = [max(v) - m for m, (_, v) in zip(means, pts)]
             ax.errorbar(xs, means, yerr=[low, high], marker="o", capsize=3,
-                        linestyle="-" if "without" not in label else ":", label=f"{arm}, {label}")
+                        linestyle=line_style[label], label=f"{arm}, {label}")
             for (d, v), m in zip(pts, means):
                 print(f"{label},{arm},{pr:g},{d:g},{len(v)},{m:.4f},{min(v):.4f},{max(v):.4f}")
         for y, style in ((1.0, "-"), (0.95, "--"), (1.05, "--")):
