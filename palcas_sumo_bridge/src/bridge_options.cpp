@@ -132,6 +132,10 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.session.guard_busy_handback = p.get<bool>("guard_busy_handback", o.session.guard_busy_handback);
   o.session.guard_busy_lc_assertive =
       p.number("guard_busy_lc_assertive", o.session.guard_busy_lc_assertive, 0.0, 100.0);
+  o.session.guard_busy_change_max_accel_mps2 = p.number(
+      "guard_busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2, 0.0, 20.0);
+  o.session.guard_busy_change_hold_s =
+      p.number("guard_busy_change_hold_s", o.session.guard_busy_change_hold_s, 0.0, 600.0);
   o.session.guard_insertion_edge = p.get<bool>("guard_insertion_edge", o.session.guard_insertion_edge);
   o.session.assist_mode = p.get<bool>("assist_mode", o.session.assist_mode);
   o.session.assist_lane_change_mode =

@@ -124,6 +124,8 @@ json bridgeJson(const BridgeOptions& o) {
           {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
           {"guard_busy_handback", o.session.guard_busy_handback},
           {"guard_busy_lc_assertive", o.session.guard_busy_lc_assertive},
+          {"guard_busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2},
+          {"guard_busy_change_hold_s", o.session.guard_busy_change_hold_s},
           {"guard_insertion_edge", o.session.guard_insertion_edge},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
@@ -262,6 +264,9 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"handback_cav_s", dt * g.handback_steps},
           {"handback_advice_dropped", g.handback_advice_dropped},
           {"busy_lc_assertive", o.session.guard_busy_lc_assertive},
+          {"busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2},
+          {"busy_change_bounds", g.busy_change_bounds},
+          {"busy_change_bound_cav_s", dt * g.busy_change_bound_steps},
           {"insertion_edge", o.session.guard_insertion_edge},
           {"lane_changes_insertion_refused", g.lane_changes_insertion_refused}};
 }

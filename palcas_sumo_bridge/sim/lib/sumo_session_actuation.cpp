@@ -49,6 +49,7 @@ bool SumoSession::wholeOnEdge(const VehicleRecord& v) const {
 void SumoSession::boundLaneChangeAcceleration(VehicleRecord& v) {
   const double accel = options_.lane_change_max_accel_mps2, decel = options_.lane_change_max_decel_mps2;
   if ((accel <= 0.0 && decel <= 0.0) || v.lane_change_bounded) return;
+  releaseBusyChangeBound(v);  // its own accel, not the busy zone's bound, is what comes back
   v.own_accel_mps2 = api::Vehicle::getAccel(v.id);
   v.own_decel_mps2 = api::Vehicle::getDecel(v.id);
   if (accel > 0.0) api::Vehicle::setAccel(v.id, std::min(accel, v.own_accel_mps2));

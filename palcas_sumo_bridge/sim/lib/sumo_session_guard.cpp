@@ -106,6 +106,36 @@ void SumoSession::setBusyGapAcceptance(VehicleRecord& v, bool busy) const {
   }
 }
 
+void SumoSession::updateBusyChangeBound(VehicleRecord& v, bool switched) {
+  const double bound = options_.guard_busy_change_max_accel_mps2;
+  if (bound <= 0.0) return;
+  // SL2015 moves a vehicle sideways within its lane too (alignment); a change is faster.
+  constexpr double kChangingLateralMps = 0.3;
+  if (v.handed_back && (switched || std::abs(v.lateral_speed_mps) > kChangingLateralMps))
+    v.busy_change_until_s = time_s_ + options_.guard_busy_change_hold_s;
+  bool bounded = v.handed_back && time_s_ < v.busy_change_until_s && !v.lane_change_bounded;
+  if (bounded && options_.guard_floor_speed_share > 0.0) {
+    // A slow or queued CAV gets going at its own rate (as the floor lifts an advised change's bound).
+    const double allowed = std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
+    bounded = v.speed_mps >= options_.guard_floor_speed_share * allowed;
+  }
+  if (bounded && !v.busy_change_bounded) {
+    v.busy_change_own_accel_mps2 = api::Vehicle::getAccel(v.id);
+    api::Vehicle::setAccel(v.id, std::min(bound, v.busy_change_own_accel_mps2));
+    v.busy_change_bounded = true;
+    ++guard_.busy_change_bounds;
+  } else if (!bounded) {
+    releaseBusyChangeBound(v);
+  }
+  if (v.busy_change_bounded) ++guard_.busy_change_bound_steps;
+}
+
+void SumoSession::releaseBusyChangeBound(VehicleRecord& v) {
+  if (!v.busy_change_bounded) return;
+  api::Vehicle::setAccel(v.id, v.busy_change_own_accel_mps2);
+  v.busy_change_bounded = false;
+}
+
 double SumoSession::guardFloorMps(const VehicleRecord& v) const {
   // In a busy zone the floor is the allowed speed itself: advice slows nobody there, the
   // zone's CAVs drive themselves (only route-serving lane changes are still carried out).

@@ -100,6 +100,8 @@ void SumoSession::readVehicles() {
     if (it == all.end()) continue;  // teleporting vehicles are off the road this step
     const libsumo::TraCIResults& r = it->second;
     const double last_x_m = v.x_m;
+    const int last_lane = v.lane;
+    const RoadPart last_part = v.part;
     auto pos = r.find(libsumo::VAR_POSITION);
     if (pos != r.end())
       if (auto p = std::dynamic_pointer_cast<libsumo::TraCIPosition>(pos->second)) {
@@ -122,6 +124,7 @@ void SumoSession::readVehicles() {
       if (v.merge_mode) updateMergeMode(v);
       updateHandback(v);
       if (v.handed_back) ++guard_.handback_steps;
+      updateBusyChangeBound(v, v.lane != last_lane || v.part != last_part);
       if (!options_.assist_mode && !v.handed_back) manageExit(v);
     }
   }

@@ -117,6 +117,14 @@ struct SessionOptions {
   /// 2 (README "Results": +8-10 % speed at 2200 veh/h/lane, PR 60 %); 0 = off (the vType's
   /// value everywhere).
   double guard_busy_lc_assertive = 2.0;
+  /// Largest acceleration [m/s^2] of a CAV in a busy zone around a lane change of its own
+  /// (handed back, or in assist mode): from when it starts moving sideways until
+  /// guard_busy_change_hold_s after it is in its new lane. Tighter gaps mean more changes and
+  /// a hard speed-up into each gap; the RSU asks for the comfort band instead, as for an
+  /// advised change (lane_change_max_accel_mps2). Not below the guard's floor
+  /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 0 = off.
+  double guard_busy_change_max_accel_mps2 = 0.0;
+  double guard_busy_change_hold_s = 4.0;
   /// The advice guard where traffic is inserted: no advised lane change is carried out on the
   /// mainline edge where SUMO inserts the mainline's vehicles (the warm-up edge); the CAV keeps
   /// its lane and drives itself, as under KEEP. SUMO 1.15 inserts a vehicle (departPos
@@ -152,6 +160,8 @@ struct GuardCounters {
   std::uint64_t handbacks = 0;                  ///< CAVs handed back to their own driving
   std::uint64_t handback_steps = 0;             ///< CAV steps spent handed back
   std::uint64_t handback_advice_dropped = 0;    ///< advisories not carried out (handed back)
+  std::uint64_t busy_change_bounds = 0;         ///< own changes in a busy zone whose accel was bounded
+  std::uint64_t busy_change_bound_steps = 0;    ///< CAV steps under that bound
   std::uint64_t zone_steps = 0;                 ///< zone steps in all (zones x steps)
 };
 
@@ -195,6 +205,10 @@ struct VehicleRecord {
   bool merge_mode = false;       ///< strategic lane changes allowed (own_merge, accel lane)
   bool handed_back = false;      ///< busy zone: its own route-aware driving, advice dropped
   std::string own_lc_assertive;  ///< its lcAssertive before a busy zone changed it (empty: unchanged)
+  /// guard_busy_change_max_accel_mps2: the bound's end [s] and the accel it replaced.
+  double busy_change_until_s = -1e18;
+  bool busy_change_bounded = false;
+  double busy_change_own_accel_mps2 = 0.0;
   /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
   /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
   /// differ (a merge edge), until the target lane is reached or the time is up.
@@ -314,6 +328,11 @@ class SumoSession {
   /// guard_busy_lc_assertive: a busy zone's gap acceptance for a CAV making its own changes,
   /// or its own value back (busy false).
   void setBusyGapAcceptance(VehicleRecord& v, bool busy) const;
+  /// guard_busy_change_max_accel_mps2: bounds a handed-back CAV's acceleration around a lane
+  /// change of its own (switched: it is in another lane or road part than a step ago), and
+  /// lifts the bound after it.
+  void updateBusyChangeBound(VehicleRecord& v, bool switched);
+  void releaseBusyChangeBound(VehicleRecord& v);
   /// Sets a CAV's route to the rest of its own (to its off-ramp); false when it is not on it.
   bool routeToOwnExit(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
