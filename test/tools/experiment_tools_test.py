@@ -29,6 +29,7 @@ import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
 import seed_ratio  # noqa: E402
 import ratio_by_demand  # noqa: E402
+import comfort_breakdown  # noqa: E402
 import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -610,6 +611,48 @@ class RatioByDemandTest(unittest.TestCase):
             with self.assertRaises(SystemExit) as e:
                 ratio_by_demand.main(argv)
             self.assertIn(words, str(e.exception))
+
+
+class ComfortBreakdownTest(unittest.TestCase):
+    """tools/comfort_breakdown.py --by-lane-change: discomfort by the time from the nearest change."""
+
+    HEADER = "time_s,vehicle,cav,route,exit_cluster,part,x_m,lane,speed_mps,accel_mps2,command,command_accel_mps2,lane_change_target"
+
+    def run_dir(self, rows):
+        d = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, d)
+        (d / "palcas").mkdir()
+        lines = [self.HEADER] + [f"{t},{v},{cav},r,-1,{part},0,{lane},20,{a},none,0,0" for t, v, cav, part, lane, a in rows]
+        (d / "palcas" / "trajectories.csv").write_text("\n".join(lines) + "\n")
+        return d
+
+    def test_samples_fall_in_the_window_of_their_nearest_change(self):
+        # CAV c1 changes lane at t = 10 (lane 1 -> 2) and its road part at t = 30; HDV h1 is not counted.
+        rows = [(t, "c1", 1, "mainline", 1, 0.0) for t in range(1, 9)]
+        rows += [(9, "c1", 1, "mainline", 1, 2.0),    # 1 s before the change: speeding up
+                 (10, "c1", 1, "mainline", 2, 0.0),   # the change itself: 0 s after
+                 (11, "c1", 1, "mainline", 2, -2.0),  # 1 s after: braking
+                 (14, "c1", 1, "mainline", 2, 3.0),   # 4 s after: speeding up
+                 (20, "c1", 1, "mainline", 2, 1.47),  # further, on the bound: comfortable
+                 (21, "c1", 1, "mainline", 2, -1.5),  # further (9 s from either): braking
+                 (30, "c1", 1, "offramp", 2, 0.0),
+                 (5, "h1", 0, "mainline", 1, 4.0)]
+        counts, total = comfort_breakdown.by_lane_change(self.run_dir(rows) / "palcas" / "trajectories.csv", 1.47)
+        self.assertEqual(total, 15)
+        self.assertEqual(counts["5-2 s before"], [3, 0, 0])  # t = 5..7 (a window's start is in it)
+        self.assertEqual(counts["2-0 s before"], [2, 1, 0])  # t = 8, 9
+        self.assertEqual(counts["0-2 s after"], [3, 0, 1])   # t = 10, 11 and the part change at 30
+        self.assertEqual(counts["2-5 s after"], [1, 1, 0])   # t = 14
+        self.assertEqual(counts[comfort_breakdown.FURTHER], [6, 0, 1])  # t = 1..4, 20, 21
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            comfort_breakdown.main([str(self.run_dir(rows)), "--by-lane-change"])
+        self.assertIn("| palcas | **all** (comfort 73.3 %) | 100 | 13.33 | 13.33 |", out.getvalue())
+
+    def test_a_folder_without_trajectories_is_named(self):
+        with self.assertRaises(SystemExit) as e:
+            comfort_breakdown.main([tempfile.gettempdir() + "/no_such_run", "--by-lane-change"])
+        self.assertIn("no <arm>/trajectories.csv", str(e.exception))
 
 
 def main():
