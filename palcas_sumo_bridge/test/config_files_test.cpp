@@ -100,6 +100,7 @@ TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
   refused("~wrong_type", "lockstep_deadline_s");         // a string deadline
   refused("~out_of_range", "penetration_rate");          // a penetration rate of 1.2
   refused("~bad_guard", "guard_floor_speed_share");      // a guard floor of 1.5 x allowed speed
+  refused("~bad_busy_change", "guard_busy_change_max_accel_mps2");  // a negative accel bound
 }
 
 int main(int argc, char** argv) {
