@@ -54,10 +54,12 @@ def breakdown(path, threshold):
 
 
 def window_of(offset_s):
+    """Each window holds its start, not its end; the last one holds its end too."""
     for label, lo, hi in LANE_CHANGE_WINDOWS:
-        if lo <= offset_s < hi or (hi == LANE_CHANGE_WINDOWS[-1][2] and offset_s == hi):
+        if lo <= offset_s < hi:
             return label
-    return FURTHER
+    last_label, _, last_end = LANE_CHANGE_WINDOWS[-1]
+    return last_label if offset_s == last_end else FURTHER
 
 
 def by_lane_change(path, threshold):

@@ -114,11 +114,9 @@ void SumoSession::updateBusyChangeBound(VehicleRecord& v, bool switched) {
   if (v.handed_back && (switched || std::abs(v.lateral_speed_mps) > kChangingLateralMps))
     v.busy_change_until_s = time_s_ + options_.guard_busy_change_hold_s;
   bool bounded = v.handed_back && time_s_ < v.busy_change_until_s && !v.lane_change_bounded;
-  if (bounded && options_.guard_floor_speed_share > 0.0) {
-    // A slow or queued CAV gets going at its own rate (as the floor lifts an advised change's bound).
-    const double allowed = std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
-    bounded = v.speed_mps >= options_.guard_floor_speed_share * allowed;
-  }
+  // A slow or queued CAV gets going at its own rate (as the floor lifts an advised change's
+  // bound); the free zones' floor, as the busy zones' own is the allowed speed itself.
+  if (bounded) bounded = v.speed_mps >= floorMps(v, options_.guard_floor_speed_share);
   if (bounded && !v.busy_change_bounded) {
     v.busy_change_own_accel_mps2 = api::Vehicle::getAccel(v.id);
     api::Vehicle::setAccel(v.id, std::min(bound, v.busy_change_own_accel_mps2));
@@ -140,7 +138,10 @@ double SumoSession::guardFloorMps(const VehicleRecord& v) const {
   // In a busy zone the floor is the allowed speed itself: advice slows nobody there, the
   // zone's CAVs drive themselves (only route-serving lane changes are still carried out).
   const bool busy = zoneBusy(zoneOf(v));
-  const double share = busy ? options_.guard_busy_floor_speed_share : options_.guard_floor_speed_share;
+  return floorMps(v, busy ? options_.guard_busy_floor_speed_share : options_.guard_floor_speed_share);
+}
+
+double SumoSession::floorMps(const VehicleRecord& v, double share) const {
   if (share <= 0.0) return 0.0;
   return share * std::min(v.max_speed_mps, api::Vehicle::getAllowedSpeed(v.id));
 }

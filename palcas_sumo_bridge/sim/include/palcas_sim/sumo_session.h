@@ -124,7 +124,8 @@ struct SessionOptions {
   /// advised change (lane_change_max_accel_mps2). Not below the guard's floor
   /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 0 = off (the
   /// default); 1.47 = a_th for a road near capacity (README "Results": comfort over
-  /// SUMO-native's at 1800-2200 veh/h/lane at the same speed, but 0.9 % slower at 1000).
+  /// SUMO-native's at 1800-2200 veh/h/lane at the same speed, but 0.4 % slower in advisory
+  /// mode at 1000-1400, ./palcas run's seed 0.9 %).
   double guard_busy_change_max_accel_mps2 = 0.0;
   double guard_busy_change_hold_s = 4.0;
   /// The advice guard where traffic is inserted: no advised lane change is carried out on the
@@ -335,6 +336,8 @@ class SumoSession {
   /// lifts the bound after it.
   void updateBusyChangeBound(VehicleRecord& v, bool switched);
   void releaseBusyChangeBound(VehicleRecord& v);
+  /// share x the CAV's allowed speed (its lane's limit, or its own top speed if lower); 0 if share <= 0.
+  double floorMps(const VehicleRecord& v, double share) const;
   /// Sets a CAV's route to the rest of its own (to its off-ramp); false when it is not on it.
   bool routeToOwnExit(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
