@@ -122,11 +122,10 @@ struct SessionOptions {
   /// guard_busy_change_hold_s after it is in its new lane. Tighter gaps mean more changes and
   /// a hard speed-up into each gap; the RSU asks for the comfort band instead, as for an
   /// advised change (lane_change_max_accel_mps2). Not below the guard's floor
-  /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 0 = off (the
-  /// default); 1.47 = a_th for a road near capacity (README "Results": comfort over
-  /// SUMO-native's at 1800-2200 veh/h/lane at the same speed, but 0.4 % slower in advisory
-  /// mode at 1000-1400, ./palcas run's seed 0.9 %).
-  double guard_busy_change_max_accel_mps2 = 0.0;
+  /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 1.47 = a_th
+  /// (the default: comfort over SUMO-native's in all 16 cells of 1000-2200 veh/h/lane at the
+  /// same speed; at 1000-1400 its speed changed by less than the seeds' noise); 0 = off.
+  double guard_busy_change_max_accel_mps2 = 1.47;
   double guard_busy_change_hold_s = 4.0;
   /// The advice guard where traffic is inserted: no advised lane change is carried out on the
   /// mainline edge where SUMO inserts the mainline's vehicles (the warm-up edge); the CAV keeps
