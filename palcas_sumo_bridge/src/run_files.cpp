@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 #include <palcas_core/common/atomic_file.h>
+#include <palcas_core/common/build_info.h>
 #include "palcas_sim/sumo_outputs.h"
 
 #include <algorithm>
@@ -147,6 +148,12 @@ json bridgeJson(const BridgeOptions& o) {
           {"sumo_warnings", o.sumo_warnings}};
 }
 
+// Runs of one command on one traffic agree to the last digit only where these agree.
+json buildJson() {
+  const BuildInfo b = buildInfo();
+  return {{"core_arch", b.arch}, {"core_simd", b.simd}, {"cpu", b.cpu}};
+}
+
 }  // namespace
 
 std::string prepareScenario(const BridgeOptions& o) {
@@ -162,6 +169,7 @@ std::string prepareScenario(const BridgeOptions& o) {
                                {"onramp_flow_vphpl", config.onramp_flow_vphpl}}},
                    {"duration_s", config.duration_s},
                    {"git_commit", o.git_commit},
+                   {"build", buildJson()},
                    {"command_line", o.command_line},
                    {"sumocfg", files.sumocfg_file}};
   writeAtomically(o.out_dir + "/manifest.json", manifest);
@@ -267,6 +275,11 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2},
           {"busy_change_bounds", g.busy_change_bounds},
           {"busy_change_bound_cav_s", dt * g.busy_change_bound_steps},
+          {"collided_cavs", g.collided_cavs},
+          {"collided_handed_back", g.collided_handed_back},
+          {"collided_busy_change_bounded", g.collided_busy_change_bounded},
+          {"collided_advised_change", g.collided_advised_change},
+          {"collided_accelerate", g.collided_accelerate},
           {"insertion_edge", o.session.guard_insertion_edge},
           {"lane_changes_insertion_refused", g.lane_changes_insertion_refused}};
 }

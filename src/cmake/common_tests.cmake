@@ -9,3 +9,5 @@ palcas_core_add_gtest(atomic_file_test test/common/atomic_file_test.cpp)
 palcas_core_add_gtest(checks_test test/common/checks_test.cpp)
 # the road's one vocabulary: codes, names, bad codes refused
 palcas_core_add_gtest(road_terms_test test/common/road_terms_test.cpp)
+# what the core was built for: Eigen's instruction sets as its users see them, the CPU
+palcas_core_add_gtest(build_info_test test/common/build_info_test.cpp)

@@ -99,8 +99,10 @@ fi
 result resume_refuses_a_corrupt_checkpoint "$why"
 
 # --demand / --ramp-demand reach the bridge: the default run folder is named by them, and
-# manifest.json, metrics.json and the generated routes file that SUMO ran show them. The same
-# run asks for two of SUMO's own outputs, which land in the arm's folder.
+# manifest.json, metrics.json and the generated routes file that SUMO ran show them; the
+# manifest also says what the core was built for, and the guard's collision attribution
+# counts every CAV collision. The same run asks for two of SUMO's own outputs, which land in
+# the arm's folder.
 status=0
 PALCAS_NO_BUILD=1 PALCAS_RESULTS_DIR="$WORK/results" timeout -k 10 300 "$ROOT/palcas" run --arm keep --no-compare \
   --scenario tiny --duration 20 --pr 40 --seed 7 --demand 1850 --ramp-demand 420 \
@@ -115,8 +117,9 @@ m = json.load(open(sys.argv[1] + "/keep/manifest.json"))
 r = json.load(open(sys.argv[1] + "/keep/metrics.json"))
 c = m["config"]["scenario"]
 print(m["demand"]["mainline_flow_vphpl"], m["demand"]["onramp_flow_vphpl"], c["mainline_flow_vphpl"],
-      r["mainline_flow_vphpl"], r["onramp_flow_vphpl"], r["throughput_vph"] is not None, "insertion_dropped" in r)' "$run_dir" 2>&1)"
-  [ "$got" = "1850.0 420.0 1850.0 1850.0 420.0 True True" ] || why="manifest/metrics show '$got', expected '1850.0 420.0 1850.0 1850.0 420.0 True True'"
+      r["mainline_flow_vphpl"], r["onramp_flow_vphpl"], r["throughput_vph"] is not None, "insertion_dropped" in r,
+      m["build"]["core_arch"] in ("native", "portable") and bool(m["build"]["core_simd"]), r["guard"]["collided_cavs"] == r["cav_collisions"])' "$run_dir" 2>&1)"
+  [ "$got" = "1850.0 420.0 1850.0 1850.0 420.0 True True True True" ] || why="manifest/metrics show '$got', expected '1850.0 420.0 1850.0 1850.0 420.0 True True True True'"
   [ -n "$why" ] || grep -q "mainline 1850 veh/h/lane, on-ramp 420 veh/h/lane" "$run_dir"/keep/scenario/*.rou.xml ||
     why="the routes file SUMO ran does not say 1850 / 420: $(grep -h -o 'mainline [^.]*' "$run_dir"/keep/scenario/*.rou.xml)"
   [ -n "$why" ] || grep -q "demand=1850 veh/h/lane (ramps 420 veh/h)" "$WORK/demand.log" || why="the run does not say its demand"

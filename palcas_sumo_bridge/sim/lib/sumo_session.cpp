@@ -214,6 +214,8 @@ const StepEvents& SumoSession::step() {
       }
     }
   }
+  for (const std::string& id : events_.collided)
+    if (const VehicleRecord* v = find(id)) countCollidedUnderGuard(*v, &guard_);
   // Colliding vehicles are removed (by SUMO or above) and may also be listed as arrived,
   // now or in the next step; each leaves once, and only vehicles still tracked arrive.
   for (const std::string& id : events_.collided) removeVehicle(id, &events_.removed);

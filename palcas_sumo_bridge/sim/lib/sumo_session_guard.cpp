@@ -128,6 +128,15 @@ void SumoSession::updateBusyChangeBound(VehicleRecord& v, bool switched) {
   if (v.busy_change_bounded) ++guard_.busy_change_bound_steps;
 }
 
+void countCollidedUnderGuard(const VehicleRecord& v, GuardCounters* g) {
+  if (!v.is_cav) return;
+  ++g->collided_cavs;
+  if (v.handed_back) ++g->collided_handed_back;
+  if (v.busy_change_bounded) ++g->collided_busy_change_bounded;
+  if (v.lane_change_target != 0) ++g->collided_advised_change;
+  if (v.command == HeldCommand::kAccelerate) ++g->collided_accelerate;
+}
+
 void SumoSession::releaseBusyChangeBound(VehicleRecord& v) {
   if (!v.busy_change_bounded) return;
   api::Vehicle::setAccel(v.id, v.busy_change_own_accel_mps2);

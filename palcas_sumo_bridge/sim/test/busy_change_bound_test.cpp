@@ -20,7 +20,6 @@ using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
 
 namespace {
-constexpr int OWN_LANE_CHANGE_MODE = 1621;
 constexpr double BOUND_MPS2 = 1.2, HOLD_S = 3.0, FLOOR_SHARE = 0.3;
 
 // A handed-back CAV in zone 0 that drives through (no off-ramp to turn into), with a lane to
@@ -37,18 +36,8 @@ std::string pickCav(const SumoSession& session) {
 }  // namespace
 
 TEST(BusyChangeBound, AnOwnChangeInABusyZoneAcceleratesGentlyThenItsOwnAccelComesBack) {
-  SessionOptions options = palcas::sim::test::sessionOnTiny("busy_change_bound", 5);
-  // Every zone is busy: no zone's speed share reaches 1.5 of its top speeds.
-  options.guard_busy_speed_share = 1.5;
-  options.guard_busy_leave_share = 1.6;
-  options.guard_busy_window_s = 1.0;
-  options.guard_busy_handback = true;
-  options.assist_lane_change_mode = OWN_LANE_CHANGE_MODE;
-  options.guard_busy_lc_assertive = 0.0;
-  options.guard_floor_speed_share = FLOOR_SHARE;
-  options.guard_busy_change_max_accel_mps2 = BOUND_MPS2;
-  options.guard_busy_change_hold_s = HOLD_S;
-  options.guard_insertion_edge = false;
+  const SessionOptions options =
+      palcas::sim::test::sessionOnTinyEveryZoneBusy("busy_change_bound", 5, BOUND_MPS2, HOLD_S, FLOOR_SHARE);
   SumoSession session(options);
   for (int i = 0; i < 400; ++i) session.step();  // the road fills
 

@@ -78,4 +78,24 @@ inline SessionOptions sessionOnTiny(const std::string& dir_name, unsigned seed =
   return o;
 }
 
+/// sessionOnTiny with every zone busy from its first window (no zone's speed share reaches
+/// 1.5 of its top speeds), its CAVs handed back to SUMO's own lane changing (1621, default gap
+/// acceptance), and the busy zones' change bound at `bound_mps2` for `hold_s` after a change,
+/// not below `floor_share` of a CAV's allowed speed.
+inline SessionOptions sessionOnTinyEveryZoneBusy(const std::string& dir_name, unsigned seed, double bound_mps2,
+                                                 double hold_s, double floor_share) {
+  SessionOptions o = sessionOnTiny(dir_name, seed);
+  o.guard_busy_speed_share = 1.5;
+  o.guard_busy_leave_share = 1.6;
+  o.guard_busy_window_s = 1.0;
+  o.guard_busy_handback = true;
+  o.assist_lane_change_mode = 1621;
+  o.guard_busy_lc_assertive = 0.0;
+  o.guard_floor_speed_share = floor_share;
+  o.guard_busy_change_max_accel_mps2 = bound_mps2;
+  o.guard_busy_change_hold_s = hold_s;
+  o.guard_insertion_edge = false;
+  return o;
+}
+
 }  // namespace palcas::sim::test

@@ -165,6 +165,12 @@ struct GuardCounters {
   std::uint64_t busy_change_bounds = 0;         ///< own changes in a busy zone whose accel was bounded
   std::uint64_t busy_change_bound_steps = 0;    ///< CAV steps under that bound
   std::uint64_t zone_steps = 0;                 ///< zone steps in all (zones x steps)
+  // Which guard, if any, had a hand on a CAV when it collided (a CAV can count in several).
+  std::uint64_t collided_cavs = 0;                 ///< CAVs removed after a collision
+  std::uint64_t collided_handed_back = 0;          ///< ... handed back to their own driving
+  std::uint64_t collided_busy_change_bounded = 0;  ///< ... under the busy zones' change bound
+  std::uint64_t collided_advised_change = 0;       ///< ... with an advised lane change under way
+  std::uint64_t collided_accelerate = 0;          ///< ... holding an ACCELERATE advisory
 };
 
 /// One vehicle on the road, updated every step.
@@ -223,6 +229,10 @@ struct VehicleRecord {
   double last_lane_change_s = -1e18;
   double own_accel_mps2 = 0.0, own_decel_mps2 = 0.0;
 };
+
+/// Counts a vehicle that collided in `g`'s collided_* counters (CAVs only), by the guard
+/// states it was in during its last step: whether a guard was involved in a collision.
+void countCollidedUnderGuard(const VehicleRecord& v, GuardCounters* g);
 
 /// What happened during one step besides vehicles moving.
 struct StepEvents {
