@@ -11,3 +11,4 @@ palcas_core_add_gtest(checks_test test/common/checks_test.cpp)
 palcas_core_add_gtest(road_terms_test test/common/road_terms_test.cpp)
 # what the core was built for: Eigen's instruction sets as its users see them, the CPU
 palcas_core_add_gtest(build_info_test test/common/build_info_test.cpp)
+target_compile_definitions(build_info_test PRIVATE PALCAS_CORE_ARCH_EXPECTED="${PALCAS_CORE_ARCH_NAME}")
