@@ -1,6 +1,6 @@
 // The guard's start (SessionOptions::guard_busy_at_start) on the tiny road, in-process. A road
 // that fills near capacity is advised in its first minute while its zones still count as free,
-// and that advice set off the breakdown (docs/experiment/README.md, "Advice while the road
+// and that advice set off the breakdown (docs/journal/experiments.md, "Advice while the road
 // fills"). With the option on, every zone counts as busy from the start and its CAVs drive
 // themselves until the zone has shown that it runs free. One libsumo simulation per process.
 #include <gtest/gtest.h>
