@@ -80,7 +80,7 @@ struct ScenarioConfig {
   /// On-ramp flows start at the ramp's beginning (one lane), as fast as is safe.
   InsertionSettings onramp_insertion{"first", "base", "max"};
   /// SUMO --max-depart-delay: a vehicle that waited longer for insertion is dropped. The
-  /// paper's demand exceeds what the lanes carry, so this bounds the queue; < 0 = never drop.
+  /// paper's printed demand exceeds what the lanes carry, so this bounds the queue; < 0 = never drop.
   double max_depart_delay_s = 10.0;
   /// SUMO --time-to-teleport: a vehicle stuck this long is teleported; < 0 = never.
   double time_to_teleport_s = 300.0;
