@@ -114,8 +114,8 @@ struct SessionOptions {
   /// default 1). The RSU sees every vehicle around the CAV, so in a busy zone it can clear the
   /// CAV for a gap its own sensors would not take: merges and exit changes into dense lanes
   /// happen sooner instead of queueing. Its own value comes back when the zone is free.
-  /// 2 (README "Results": +8-10 % speed at 2200 veh/h/lane, PR 60 %); 0 = off (the vType's
-  /// value everywhere).
+  /// 2 (chosen near capacity: docs/journal/experiments.md, "Tighter gaps in busy zones"; the
+  /// rule arms carry it too, sumo_native does not); 0 = off (the vType's value everywhere).
   double guard_busy_lc_assertive = 2.0;
   /// Largest acceleration [m/s^2] of a CAV in a busy zone around a lane change of its own
   /// (handed back, or in assist mode): from when it starts moving sideways until
@@ -123,8 +123,8 @@ struct SessionOptions {
   /// a hard speed-up into each gap; the RSU asks for the comfort band instead, as for an
   /// advised change (lane_change_max_accel_mps2). Not below the guard's floor
   /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 1.47 = a_th
-  /// (the default: comfort over SUMO-native's in all 16 cells of 1000-2200 veh/h/lane at the
-  /// same speed; at 1000-1400 its speed changed by less than the seeds' noise); 0 = off.
+  /// (the default: docs/journal/experiments.md, "Gentle acceleration around a busy zone's own
+  /// lane changes"); 0 = off.
   double guard_busy_change_max_accel_mps2 = 1.47;
   double guard_busy_change_hold_s = 4.0;
   /// The advice guard where traffic is inserted: no advised lane change is carried out on the
