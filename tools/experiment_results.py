@@ -33,10 +33,18 @@ WORST_OF = ("efficiency_all_mps", "dsr_pct")
 SPEED = "efficiency_all_mps"
 JAM_SHARE = 0.5  # a point below this share of SUMO-native's speed on the same traffic jammed
 REFERENCE_ARM = "sumo_native"
+# Further columns of results.csv, straight from each point's metrics.json (a key the run's
+# bridge did not write yet: an empty cell). The raw counts are here so rates can be pooled
+# over seeds (e.g. CR = sum cav_collisions / sum cavs_seen; tools/trial_results.py).
 EXTRA = ["efficiency_cav_mps", "insertion_dropped", "mean_travel_time_s", "lane_changes_per_cav",
          "decision_ms_p99", "lane_changes_dropped", "collisions",
          "teleports", "cavs_seen", "exiting_cavs", "merging_cavs", "sim_seconds",
-         "wall_seconds", "real_time_factor"]
+         "wall_seconds", "real_time_factor",
+         # the trial's columns: speed after the road filled, who never got on, time spent,
+         # exit/merge success with the CAVs still on the road at the end counted as not served
+         "efficiency_steady_mps", "insertion_waiting_end", "unserved_vehicles",
+         "total_time_spent_veh_h", "exiting_cavs_censored", "dsr_censored_pct",
+         "merging_cavs_censored", "msr_censored_pct", "cav_collisions", "exits_ok", "arrived"]
 
 
 def read_paper(path=PAPER_RESULTS):

@@ -35,8 +35,9 @@ from junit_runner import run_as_junit  # noqa: E402
 
 
 def args(**kw):
-    base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, duration=600.0, scenario="tiny",
-                policy=None, jobs=1, demands=None, v2x="", bridge_params="")
+    # The dev seed set (101, 102, ...): the fake points below are named after its seeds.
+    base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, seed_set="dev", duration=600.0,
+                scenario="tiny", policy=None, jobs=1, demands=None, v2x="", bridge_params="")
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -146,6 +147,48 @@ class PlannerTest(unittest.TestCase):
                     experiment.merge_settings(self.out, with_file)
                 self.assertIn(key, str(e.exception))
 
+    def test_seeds_come_from_a_named_set(self):
+        s = experiment.settings_from_args(args(seed_set="test", seeds=3))
+        self.assertEqual((s["seed_set"], s["seeds"]), ("test", [1001, 1002, 1003]))
+        self.assertEqual(experiment.settings_from_args(args())["seed_set"], "dev")
+        # The command line's default is the test set.
+        _, a = experiment.parse(["--out", str(self.out), "--arms", "keep", "--scenario", "tiny"])
+        self.assertEqual(a.seed_set, "test")
+        self.assertEqual(experiment.settings_from_args(a)["seeds"], [1001, 1002, 1003])
+        for kw, text in ((dict(seed_set="test", seeds=31), "seed set 'test' has 30 seeds (1001-1030), not 31"),
+                         (dict(seed_set="nope"), "unknown seed set 'nope' (config/seeds.yaml has dev, test)")):
+            with self.assertRaisesRegex(experiment.UsageError, text.replace("(", r"\(").replace(")", r"\)")):
+                experiment.settings_from_args(args(**kw))
+        experiment.save_settings(self.out, s)
+        self.assertEqual(json.loads((self.out / "experiment.json").read_text())["seed_set"], "test")
+
+    def test_an_experiment_keeps_its_seed_set(self):
+        experiment.save_settings(self.out, experiment.settings_from_args(args(seed_set="test")))
+        with self.assertRaisesRegex(experiment.UsageError, "seed set 'test' .*not on seed set 'dev'"):
+            experiment.merge_settings(self.out, experiment.settings_from_args(args(seed_set="dev")))
+        merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(seed_set="test", seeds=4)))
+        self.assertEqual(merged["seeds"], [1001, 1002, 1003, 1004])
+        # A folder from before the seed sets (101.. and no seed_set) is the dev set's.
+        old = experiment.settings_from_args(args())
+        del old["seed_set"]
+        experiment.save_settings(self.out, old)
+        self.assertEqual(experiment.merge_settings(self.out, experiment.settings_from_args(args(seeds=3)))["seed_set"],
+                         "dev")
+        with self.assertRaisesRegex(experiment.UsageError, "seed set 'dev'"):
+            experiment.merge_settings(self.out, experiment.settings_from_args(args(seed_set="test")))
+
+    def test_training_seeds_are_still_refused(self):
+        policy = self.out / "policy"
+        shutil.copytree(ROOT / "policies" / "palcas", policy,
+                        ignore=shutil.ignore_patterns("checkpoints", "*.csv", "*.md", "*.png"))
+        (policy / "checkpoints").mkdir()
+        record = json.loads((policy / "train.json").read_text())
+        record.update(seed=1000, episodes=3)  # trained on 1000, 1001, 1002
+        (policy / "train.json").write_text(json.dumps(record))
+        with self.assertRaisesRegex(experiment.UsageError, r"seed\(s\) \[1001, 1002\] were training seeds"):
+            experiment.settings_from_args(args(arms="palcas", seed_set="test", seeds=3, scenario="paper",
+                                               policy=[f"palcas={policy}"]))
+
     def test_continuation_extends_but_never_changes_duration(self):
         s = experiment.settings_from_args(args())
         experiment.save_settings(self.out, s)
@@ -202,6 +245,26 @@ class CollectorTest(unittest.TestCase):
         md = (self.out / "tables.md").read_text()
         self.assertIn("keep_pr60_s103 (incomplete)", md)
         self.assertIn("keep_pr60_s104 (failed)", md)
+
+    def test_the_trials_columns_are_in_results_csv(self):
+        # A bridge that writes the new keys: their values; one from before them: empty cells.
+        m = self.out / "points" / "keep_pr60_s101" / "keep" / "metrics.json"
+        d = json.loads(m.read_text())
+        d.update(efficiency_steady_mps=21.5, unserved_vehicles=7, dsr_censored_pct=88.0, cav_collisions=1,
+                 cavs_seen=400, exits_ok=90, exiting_cavs=100, exiting_cavs_censored=3)
+        m.write_text(json.dumps(d))
+        experiment_results.collect(self.out, self.s, self.pts)
+        rows = {r["point"]: r for r in read_csv(self.out / "results.csv")}
+        for key in ("efficiency_steady_mps", "insertion_waiting_end", "unserved_vehicles", "total_time_spent_veh_h",
+                    "exiting_cavs_censored", "dsr_censored_pct", "merging_cavs_censored", "msr_censored_pct",
+                    "cav_collisions", "cavs_seen", "exits_ok", "exiting_cavs", "arrived", "throughput_vph",
+                    "lane_changes_per_cav", "comfort_share_pct", "collision_rate_pct", "efficiency_all_mps",
+                    "insertion_dropped", "decision_ms_p99"):
+            self.assertIn(key, rows["keep_pr60_s101"], key)
+        self.assertEqual((rows["keep_pr60_s101"]["efficiency_steady_mps"], rows["keep_pr60_s101"]["unserved_vehicles"],
+                          rows["keep_pr60_s101"]["exiting_cavs_censored"]), ("21.5", "7", "3"))
+        self.assertEqual((rows["keep_pr60_s102"]["efficiency_steady_mps"], rows["keep_pr60_s102"]["dsr_censored_pct"]),
+                         ("", ""))
 
     def test_experiments_run_apart_merge_into_one_table(self):
         experiment_results.collect(self.out, self.s, self.pts)

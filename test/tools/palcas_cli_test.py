@@ -283,13 +283,13 @@ class LaunchRunner(unittest.TestCase):
                                   demands=None, v2x="", jobs=1))
         settings = experiment.settings_from_args(a)
         experiment.save_settings(self.out, settings)
-        self.assertEqual(experiment.run_point(self.out, "keep_pr60_s101"), 0)
-        record = json.loads((self.out / "points" / "keep_pr60_s101" / "point.json").read_text())
+        self.assertEqual(experiment.run_point(self.out, "keep_pr60_s1001"), 0)
+        record = json.loads((self.out / "points" / "keep_pr60_s1001" / "point.json").read_text())
         self.assertEqual(record["status"], "done")
-        self.assertTrue(record["command"].startswith("%s run --arm keep --no-compare --pr 60 --seed 101" % (ROOT / "palcas")))
+        self.assertTrue(record["command"].startswith("%s run --arm keep --no-compare --pr 60 --seed 1001" % (ROOT / "palcas")))
         # roslaunch's parent is this process: no ./palcas (bash) in between.
         self.assertIn("palcas_cli_test.py", (self.notes / "parent").read_text())
-        self.assertIn("[palcas] results:", (self.out / "points" / "keep_pr60_s101" / "point.log").read_text())
+        self.assertIn("[palcas] results:", (self.out / "points" / "keep_pr60_s1001" / "point.log").read_text())
         plan = experiment.points_of(settings)
         self.assertTrue(experiment.finished(self.out, plan[0], 60.0))
 

@@ -2,7 +2,8 @@
 independent run of ./palcas run's code (palcas_cli.run), several at a time in threads.
 
   ./palcas experiment --out DIR [--arms a,b] [--prs 5,10] [--demands 1000,1400] [--seeds N]
-                      [--duration S] [--scenario NAME] [--policy ARM=DIR ...] [--jobs J]
+                      [--seed-set dev|test] [--duration S] [--scenario NAME]
+                      [--policy ARM=DIR ...] [--jobs J]
   ./palcas experiment --plan (same options): write DIR/plan.txt (one command per point) and
                       DIR/slurm_array.sh, run nothing
   ./palcas experiment --point NAME --out DIR   run one planned point (what plan.txt calls)
@@ -16,6 +17,11 @@ veh/h per lane) is a dimension beside arms, PRs and seeds; without it every poin
 scenario's own demand, as experiments did before it. A point is finished when its
 metrics.json covers the whole duration; finished points are never run again, so an
 interrupted experiment continues where it stopped.
+
+Seeds: --seeds N takes the first N seeds of a named set of config/seeds.yaml (--seed-set,
+default test): settings are chosen on dev (101-130), results are reported on test
+(1001-1030), never tuned on. experiment.json records the set (seed_set); a folder is extended
+only with seeds of its own set. A seed a policy trained on is refused either way.
 """
 import argparse
 import concurrent.futures
@@ -34,10 +40,10 @@ from palcas_cli import Console, ROOT, launch, options, run
 from palcas_cli.options import OptionError
 import experiment_results
 import policy_folder
+import seed_sets
 from palcas_arms import ALL_ARMS, LEARNING_ARMS
 
 PAPER_PRS = (5, 10, 20, 40, 60)
-FIRST_EVAL_SEED = 101  # the shipped policies trained on seeds 1..36 at most
 # Settings that define the experiment: a continuation must not change them.
 FIXED_KEYS = ("duration_s", "scenario", "v2x", "bridge_params")
 # Files every point runs with: settings key, ./palcas run option.
@@ -104,7 +110,11 @@ def settings_from_args(a):
         if not sep or arm not in LEARNING_ARMS:
             raise UsageError(f"--policy: '{item}' is not ARM=DIR with a learning arm")
         policies[arm] = str(pathlib.Path(path).resolve())
-    seeds = list(range(FIRST_EVAL_SEED, FIRST_EVAL_SEED + a.seeds))
+    seed_set = getattr(a, "seed_set", None) or seed_sets.DEFAULT
+    try:
+        seeds = seed_sets.seeds(seed_set, a.seeds)
+    except seed_sets.SeedSetError as e:
+        raise UsageError(f"--seed-set {seed_set} --seeds {a.seeds}: {e}")
     for arm in arms:
         if arm not in LEARNING_ARMS:
             continue
@@ -122,7 +132,7 @@ def settings_from_args(a):
             raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
                              f"seeds of {policy}")
         policies[arm] = policy
-    settings = {"arms": arms, "prs": prs, "seeds": seeds, "duration_s": float(a.duration),
+    settings = {"arms": arms, "prs": prs, "seeds": seeds, "seed_set": seed_set, "duration_s": float(a.duration),
                 "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
     if demands is not None:
         settings["demands"] = demands
@@ -136,13 +146,20 @@ def settings_from_args(a):
 
 def merge_settings(out, wanted):
     """The experiment's settings: new, or the stored ones extended by new arms/PRs/seeds.
-    A changed duration or road is refused (it would mix two experiments in one table)."""
+    A changed duration, road or seed set is refused (it would mix two experiments in one table)."""
     f = out / "experiment.json"
     if not f.exists():
         return wanted
     have = json.loads(f.read_text())
     for key, _ in POINT_FILES:  # an experiment from before these options ran without them
         have.setdefault(key, "")
+    have_set = have.get("seed_set") or seed_sets.set_of(have["seeds"])  # a folder from before seed sets
+    if have_set != wanted["seed_set"]:
+        said = f"seed set '{have_set}' (seeds {seed_sets.describe(have['seeds'])})" if have_set else \
+            f"seeds {seed_sets.describe(have['seeds'])} (in no one set of config/seeds.yaml)"
+        raise UsageError(f"{out} holds an experiment on {said}, not on seed set "
+                         f"'{wanted['seed_set']}': two seed sets do not mix in one experiment "
+                         f"(choose on dev, report on test); use another --out")
     for key in FIXED_KEYS:
         if have[key] != wanted[key]:
             raise UsageError(f"{out} holds an experiment with {key} = {have[key]}, not "
@@ -155,7 +172,7 @@ def merge_settings(out, wanted):
         said = "--demands " + ",".join(f"{d:g}" for d in have["demands"]) if "demands" in have \
             else "the scenario's own demand (no --demands)"
         raise UsageError(f"{out} holds an experiment run at {said}: give the same kind, or use another --out")
-    merged = dict(have)
+    merged = dict(have, seed_set=have_set)
     for key in ("arms", "prs", "seeds", "demands"):
         if key in have:
             merged[key] = have[key] + [v for v in wanted[key] if v not in have[key]]
@@ -362,7 +379,11 @@ def common_options(p):
     p.add_argument("--prs", default=",".join(str(x) for x in PAPER_PRS))
     p.add_argument("--demands", default=None,
                    help="mainline demands [veh/h per lane]; default: the scenario's own")
-    p.add_argument("--seeds", type=int, default=3)
+    p.add_argument("--seeds", type=int, default=3,
+                   help="the first N seeds of the seed set (default 3)")
+    p.add_argument("--seed-set", dest="seed_set", default=seed_sets.DEFAULT, metavar="dev|test",
+                   help="a set of config/seeds.yaml: dev (settings are chosen on it) or test "
+                        "(reporting only; default)")
     p.add_argument("--duration", type=float, default=1800.0)
     p.add_argument("--scenario", default="paper")
     p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
