@@ -1,0 +1,317 @@
+#!/usr/bin/env python3
+"""Tests of the fair trial's results page (tools/trial_results.py), its statistics
+(tools/palcas_stats.py: paired and bootstrap intervals, Clopper-Pearson) and the seed sets
+(tools/seed_sets.py, config/seeds.yaml), on a hand-made FIXTURE (fixtures/trial/: 2 demands x
+PR 60 x palcas, keep, sumo_native x seeds 1001-1003, one point failed, one missing, one arm
+from a bridge without the censored rates; its page as generated in fixtures/trial/expected/).
+
+usage: trial_results_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
+import contextlib
+import io
+import json
+import math
+import pathlib
+import shutil
+import sys
+import tempfile
+import unittest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+FIXTURE = pathlib.Path(__file__).resolve().parent / "fixtures" / "trial"
+EXPECTED = FIXTURE / "expected"
+sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import palcas_stats  # noqa: E402
+import seed_sets  # noqa: E402
+import trial_results  # noqa: E402
+from junit_runner import run_as_junit  # noqa: E402
+
+SPEED = trial_results.SPEED
+LOW = (1000.0, 60.0)
+HIGH = (2200.0, 60.0)
+SEEDS = [1001, 1002, 1003]
+
+
+def fixture_rows():
+    return trial_results.read_trial(FIXTURE, EXPECTED)[0]
+
+
+def scipy_available():
+    try:
+        import scipy.stats  # noqa: F401
+        return True
+    except ImportError:
+        return False
+
+
+class ClopperPearsonTest(unittest.TestCase):
+    KNOWN = (((0, 100), (0.0, 0.0362)), ((5, 100), (0.0164, 0.1128)), ((50, 100), (0.3983, 0.6017)),
+             ((100, 100), (0.9638, 1.0)), ((1, 10), (0.0025, 0.4450)), ((0, 1), (0.0, 0.975)))
+
+    def test_known_intervals_with_the_own_beta_quantile(self):
+        for (k, n), (lo, hi) in self.KNOWN:
+            got = palcas_stats.clopper_pearson(k, n, use_scipy=False)
+            self.assertAlmostEqual(got[0], lo, places=4, msg=f"{k} of {n}")
+            self.assertAlmostEqual(got[1], hi, places=4, msg=f"{k} of {n}")
+        # 0 of n: the upper bound has a closed form, 1 - 0.025^(1/n).
+        self.assertAlmostEqual(palcas_stats.clopper_pearson(0, 100, use_scipy=False)[1],
+                               1 - 0.025 ** (1 / 100), places=12)
+
+    def test_scipy_and_the_own_quantile_agree(self):
+        if not scipy_available():
+            self.skipTest("scipy is not importable: the own quantile is the one in use")
+        for k, n in ((0, 100), (5, 100), (3, 2400), (17, 9000), (4999, 10000)):
+            a = palcas_stats.clopper_pearson(k, n, use_scipy=True)
+            b = palcas_stats.clopper_pearson(k, n, use_scipy=False)
+            self.assertAlmostEqual(a[0], b[0], places=10)
+            self.assertAlmostEqual(a[1], b[1], places=10)
+
+    def test_incomplete_beta_and_its_quantile(self):
+        self.assertAlmostEqual(palcas_stats.betainc_reg(2, 3, 0.4), 0.5248, places=12)  # 1 - sum of binomials
+        self.assertAlmostEqual(palcas_stats.betainc_reg(1, 1, 0.3), 0.3, places=12)
+        self.assertAlmostEqual(palcas_stats.betainc_reg(0.5, 0.5, 0.5), 0.5, places=12)
+        for q, a, b in ((0.025, 5, 96), (0.975, 6, 95), (0.5, 2, 2)):
+            self.assertAlmostEqual(palcas_stats.betainc_reg(a, b, palcas_stats.beta_ppf(q, a, b)), q, places=12)
+        for bad in ((0, 0), (101, 100), (-1, 5)):
+            with self.assertRaises(ValueError):
+                palcas_stats.clopper_pearson(*bad)
+
+
+class IntervalTest(unittest.TestCase):
+    def test_paired_t_interval(self):
+        mean, lo, hi = palcas_stats.t_interval([0.4, 0.55, 0.55])
+        self.assertAlmostEqual(mean, 0.5)
+        self.assertAlmostEqual(hi - mean, 4.303 * math.sqrt(0.0075) / math.sqrt(3), places=9)
+        self.assertTrue(math.isnan(palcas_stats.t_interval([1.0])[1]))
+
+    def test_bootstrap_is_seeded_and_reproducible(self):
+        d = [0.31, -0.12, 0.83, 0.27, 0.55, 0.04, 0.46, 1.13, -0.37, 0.61, 0.19, 0.72]
+        a = palcas_stats.bootstrap_mean_ci(d, seed=palcas_stats.stable_seed("x", 1))
+        self.assertEqual(a, palcas_stats.bootstrap_mean_ci(d, seed=palcas_stats.stable_seed("x", 1)))
+        self.assertNotEqual(a, palcas_stats.bootstrap_mean_ci(d, seed=palcas_stats.stable_seed("x", 2)))
+        self.assertTrue(min(d) <= a[0] < sum(d) / len(d) < a[1] <= max(d))
+        self.assertEqual(palcas_stats.stable_seed("a", 1.0), palcas_stats.stable_seed("a", 1.0))
+        self.assertEqual(palcas_stats.bootstrap_mean_ci([2.0], seed=1), (2.0, 2.0))
+        with self.assertRaises(ValueError):
+            palcas_stats.bootstrap_mean_ci([1.0, float("nan")], seed=1)
+
+    def test_a_comparison_is_the_same_whatever_ran_before(self):
+        rows = fixture_rows()
+        first = trial_results.compare(rows, "palcas", "sumo_native", LOW, SPEED, SEEDS)
+        trial_results.compare(rows, "palcas", "keep", HIGH, "dsr", SEEDS)  # draws from another generator
+        again = trial_results.compare(rows, "palcas", "sumo_native", LOW, SPEED, SEEDS)
+        self.assertEqual((first["b_lo"], first["b_hi"]), (again["b_lo"], again["b_hi"]))
+
+
+class PairingTest(unittest.TestCase):
+    def test_only_seeds_both_arms_finished_are_paired_the_rest_named(self):
+        rows = fixture_rows()
+        pairs, left, column, fallback = trial_results.pair(rows, "palcas", "keep", HIGH, SPEED, SEEDS)
+        self.assertEqual([(s, a, b) for s, a, b in pairs], [(1001, 21.0, 21.3), (1002, 19.6, 19.0)])
+        self.assertEqual(left, [(1003, "keep: failed")])
+        self.assertEqual((column, fallback), (SPEED, False))
+        _, left, _, _ = trial_results.pair(rows, "palcas", "sumo_native", HIGH, SPEED, SEEDS)
+        self.assertEqual(left, [(1003, "sumo_native: no row")])
+        c = trial_results.compare(rows, "palcas", "keep", HIGH, SPEED, SEEDS)
+        self.assertEqual(c["n"], 2)
+        self.assertAlmostEqual(c["mean"], 0.15)
+        self.assertAlmostEqual(c["worst"], -0.3)  # the seed least favourable to palcas
+        self.assertEqual(c["worst_seed"], 1001)
+
+    def test_a_seed_without_the_metric_is_left_out_and_named(self):
+        rows = [dict(r) for r in fixture_rows()]
+        for r in rows:
+            if (r["arm"], r["demand"], r["seed"]) == ("keep", 1000.0, 1002):
+                r["throughput_vph"] = ""
+        pairs, left, _, _ = trial_results.pair(rows, "palcas", "keep", LOW, "throughput_vph", SEEDS)
+        self.assertEqual([s for s, _, _ in pairs], [1001, 1003])
+        self.assertEqual(left, [(1002, "keep: no throughput_vph")])
+
+    def test_censored_rates_fall_back_together(self):
+        rows = fixture_rows()
+        # sumo_native's rows at 1000 come from a bridge without dsr_censored_pct: both sides uncensored.
+        self.assertEqual(trial_results.pair(rows, "palcas", "sumo_native", LOW, "dsr", SEEDS)[2:], ("dsr_pct", True))
+        self.assertEqual(trial_results.pair(rows, "palcas", "keep", LOW, "dsr", SEEDS)[2:], ("dsr_censored_pct", False))
+
+    def test_ratio_and_readings(self):
+        rows = fixture_rows()
+        r = trial_results.compare(rows, "palcas", "sumo_native", LOW, SPEED, SEEDS, ratio=True)
+        want = [100 * (28.4 / 28.0 - 1), 100 * (28.15 / 27.6 - 1), 100 * (28.85 / 28.3 - 1)]
+        self.assertAlmostEqual(r["mean"], sum(want) / 3)
+        self.assertEqual(trial_results.verdict(r), "gain")
+        line = trial_results.reading_line(r, pct=True)
+        self.assertRegex(line, r"^speed \+1\.8 % \[\+1\.0, \+2\.6\], worst seed \+1\.4 %: a gain$")
+        self.assertEqual(trial_results.verdict(trial_results.compare(rows, "palcas", "keep", HIGH, SPEED, SEEDS)), "none")
+        # Lower is better for time spent; lane changes are neither.
+        self.assertEqual(trial_results.verdict(
+            trial_results.compare(rows, "palcas", "sumo_native", LOW, "total_time_spent_veh_h", SEEDS)), "gain")
+        self.assertEqual(trial_results.verdict(
+            trial_results.compare(rows, "palcas", "keep", HIGH, "comfort_share_pct", SEEDS)), "loss")
+        self.assertEqual(trial_results.verdict(
+            trial_results.compare(rows, "palcas", "keep", LOW, "lane_changes_per_cav", SEEDS)), "more")
+
+    def test_verdict_needs_both_intervals_on_one_side(self):
+        base = {"n": 10, "better": "higher", "t_lo": 0.1, "t_hi": 0.5, "b_lo": 0.2, "b_hi": 0.4}
+        self.assertEqual(trial_results.verdict(base), "gain")
+        self.assertEqual(trial_results.verdict(dict(base, b_lo=-0.01)), "none")
+        self.assertEqual(trial_results.verdict(dict(base, better="lower")), "loss")
+        self.assertEqual(trial_results.verdict(dict(base, t_lo=-0.5, t_hi=-0.1, b_lo=-0.4, b_hi=-0.2,
+                                                    better="lower")), "gain")
+        self.assertEqual(trial_results.verdict(dict(base, better="neutral")), "more")
+        self.assertEqual(trial_results.verdict(dict(base, n=1, t_lo=float("nan"))), "none")
+
+
+class CellTest(unittest.TestCase):
+    def test_best_control_and_pooled_collision_rate(self):
+        a = trial_results.analyse(fixture_rows(), json.loads((FIXTURE / "trial.json").read_text()),
+                                  trial_results.load_registry())
+        self.assertEqual((a["learned"], a["controls"]), (["palcas"], ["keep", "sumo_native"]))
+        low, high = a["cells"]
+        self.assertEqual((low["best"], high["best"]), ("sumo_native", "keep"))
+        self.assertTrue(low["comparisons"][0]["best"] and low["comparisons"][0]["control"] == "sumo_native")
+        cr = high["arms"]["palcas"]["cr"]
+        self.assertEqual((cr["k"], cr["n"]), (6, 2561 + 2540 + 2555))
+        lo, hi = palcas_stats.clopper_pearson(6, 7656)
+        self.assertAlmostEqual(cr["lo"], 100 * lo)
+        self.assertAlmostEqual(cr["hi"], 100 * hi)
+        self.assertEqual(high["arms"]["keep"]["n"], 2)
+        self.assertEqual(high["arms"]["palcas"]["p99"], {"max": 5.2, "seed": 1002})
+        # Unserved vehicles: the worst seed is the highest.
+        self.assertEqual(high["arms"]["palcas"]["metrics"]["unserved_vehicles"]["worst_seed"], 1002)
+
+
+class MechanismTest(unittest.TestCase):
+    def test_the_real_registry(self):
+        import yaml
+        registry = trial_results.load_registry()
+        defaults = yaml.safe_load((ROOT / "config" / "bridge.yaml").read_text())
+        rows = {r[0]: dict(zip(trial_results.MECHANISM_HEAD, r))
+                for r in trial_results.mechanism_rows(list(registry), registry, {})}
+        self.assertEqual(list(rows), list(registry))
+        for arm, entry in registry.items():
+            r = rows[arm]
+            self.assertEqual(r["RSUs"], entry["rsus"])
+            self.assertEqual(r["advisory control"], "yes" if entry["advisory_control"] else "no")
+            guard = [r[k] for k in trial_results.MECHANISM_HEAD[8:12]]
+            if not entry["advisory_control"]:
+                self.assertEqual(guard, ["—"] * 4, arm)
+                continue
+            params = dict(defaults)
+            own = ROOT / "policies" / arm / "bridge.yaml"
+            if entry["shipped_policy"] and own.exists():
+                params.update(yaml.safe_load(own.read_text()))
+            elif entry.get("bridge_params"):
+                params.update(yaml.safe_load((ROOT / "config" / entry["bridge_params"]).read_text()))
+            lc = float(params["guard_busy_lc_assertive"])
+            self.assertEqual(r["busy-zone gap acceptance"], f"lcAssertive {lc:.1f}" if lc > 0 else "off", arm)
+            self.assertEqual(r["busy-zone hand-back"], "on" if params["guard_busy_handback"] else "off", arm)
+            for col, key in (("busy-zone change bound", "guard_busy_change_max_accel_mps2"),
+                             ("advised-change accel. bound", "lane_change_max_accel_mps2")):
+                v = float(params[key])
+                self.assertEqual(r[col], f"{v:g} m/s²" if v > 0 else "off", (arm, col))
+        self.assertEqual(rows["sumo_native"]["advice"], "none")
+        self.assertEqual(rows["palcas"]["advice"], "learned network")
+        self.assertIn("policies/palcas/bridge.yaml", rows["palcas"]["bridge files over config/bridge.yaml"])
+
+    def test_advice_is_the_field_else_inferred_from_the_rsus(self):
+        self.assertEqual(trial_results.advice_of({"rsus": "zones"}), "network")
+        self.assertEqual(trial_results.advice_of({"rsus": "none"}), "none")
+        self.assertEqual(trial_results.advice_of({"rsus": "zones", "advice": "rules"}), "rules")
+        self.assertEqual(trial_results.ADVICE_WORDS[trial_results.advice_of({"rsus": "central"})], "learned network")
+
+
+class PageTest(unittest.TestCase):
+    def setUp(self):
+        self.out = pathlib.Path(tempfile.mkdtemp(prefix="palcas_trial_test_"))
+
+    def tearDown(self):
+        shutil.rmtree(self.out, ignore_errors=True)
+
+    def test_the_committed_fixture_page_is_current(self):
+        self.assertIsNone(trial_results.check(FIXTURE, EXPECTED))
+
+    def test_the_page_is_deterministic(self):
+        a, _ = trial_results.generate(FIXTURE, EXPECTED)
+        b, _ = trial_results.generate(FIXTURE, EXPECTED)
+        self.assertEqual(a, b)
+        page = a["RESULTS.md"]
+        self.assertIn("`keep` 2200 / PR 60 s1003: failed ([FATAL] rsu_0: fixture failure)", page)
+        self.assertIn("`sumo_native` 2200 / PR 60 s1003: missing (no row)", page)
+        self.assertIn("Seeds (3, set `test` of config/seeds.yaml): 1001, 1002, 1003", page)
+        self.assertIn("- `palcas` vs `keep`: seeds left out: s1003 (keep: failed)", page)
+        self.assertIn("- `palcas` vs best control (sumo_native), 3 paired seeds: speed +1.8 % [+1.0, +2.6]", page)
+
+    def test_check_names_the_first_difference(self):
+        with contextlib.redirect_stdout(io.StringIO()):
+            trial_results.main([str(FIXTURE), "--out", str(self.out / "page")])
+        page = self.out / "page" / "RESULTS.md"
+        self.assertIsNone(trial_results.check(FIXTURE, self.out / "page"))
+        text = page.read_text()
+        page.write_text(text.replace("28.47 ± 0.88", "28.48 ± 0.88", 1))
+        diff = trial_results.check(FIXTURE, self.out / "page")
+        self.assertIn("RESULTS.md line", diff)
+        self.assertIn("28.48 ± 0.88", diff)
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.assertEqual(trial_results.main([str(FIXTURE), "--out", str(self.out / "page"), "--check"]), 1)
+        self.assertIn("28.48", err.getvalue())
+        page.write_text(text)
+        (self.out / "page" / "results" / "paired.csv").unlink()
+        self.assertIn("paired.csv is missing", trial_results.check(FIXTURE, self.out / "page"))
+
+    def test_writing_gives_what_check_accepts(self):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            self.assertEqual(trial_results.main([str(FIXTURE), "--out", str(self.out)]), 0)
+        self.assertTrue((self.out / "results" / "speed_ratio.png").stat().st_size > 5000)
+        self.assertTrue((self.out / "results" / "paired_seeds.png").stat().st_size > 5000)
+        self.assertIsNone(trial_results.check(FIXTURE, self.out))
+        (self.out / "results" / "old.csv").write_text("x\n")
+        self.assertIn("old.csv is not generated", trial_results.check(FIXTURE, self.out))
+
+    def test_bad_input_is_named(self):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.assertEqual(trial_results.main([str(self.out / "nope"), "--out", str(self.out)]), 2)
+        self.assertIn("no such folder", err.getvalue())
+        twice = self.out / "twice"
+        twice.mkdir()
+        shutil.copy(FIXTURE / "results.csv", twice / "a.csv")
+        shutil.copy(FIXTURE / "results.csv", twice / "b.csv")
+        with self.assertRaisesRegex(trial_results.TrialError, "is also in"):
+            trial_results.read_trial(twice)
+
+    def test_the_committed_results_page_is_current(self):
+        trial = ROOT / "docs" / "trial"
+        if not trial.is_dir():
+            self.skipTest("no docs/trial yet: no committed trial results")
+        self.assertIsNone(trial_results.check(trial, ROOT / "docs"))
+
+
+class SeedSetsTest(unittest.TestCase):
+    def test_the_sets(self):
+        sets = seed_sets.load()
+        self.assertEqual(sets["dev"], list(range(101, 131)))
+        self.assertEqual(sets["test"], list(range(1001, 1031)))
+        self.assertEqual(seed_sets.seeds("dev", 3), [101, 102, 103])
+        self.assertEqual(seed_sets.set_of([1001, 1030]), "test")
+        self.assertIsNone(seed_sets.set_of([101, 1001]))
+        with self.assertRaisesRegex(seed_sets.SeedSetError, r"seed set 'dev' has 30 seeds \(101-130\), not 31"):
+            seed_sets.seeds("dev", 31)
+        with self.assertRaisesRegex(seed_sets.SeedSetError, "unknown seed set 'x'"):
+            seed_sets.seeds("x", 1)
+
+    def test_a_seed_in_two_sets_is_refused(self):
+        d = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, d)
+        (d / "seeds.yaml").write_text("dev: [1, 2]\ntest: [2, 3]\n")
+        with self.assertRaisesRegex(seed_sets.SeedSetError, "seed 2 is also in set 'dev'"):
+            seed_sets.load(d / "seeds.yaml")
+
+
+def main():
+    run_as_junit(sys.modules[__name__], "trial_results")
+
+
+if __name__ == "__main__":
+    main()

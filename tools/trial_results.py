@@ -1,0 +1,952 @@
+#!/usr/bin/env python3
+"""The fair trial's results page: docs/RESULTS.md and its figures and CSVs under
+docs/results/, regenerated from the committed trial results.
+
+  /usr/bin/python3 tools/trial_results.py docs/trial            write docs/RESULTS.md, docs/results/
+  /usr/bin/python3 tools/trial_results.py docs/trial --check    regenerate in memory; exit 1 naming
+                                                                 the first difference from the committed page
+  ... --out DIR      the page as DIR/RESULTS.md, figures and CSVs in DIR/results/ (default docs)
+
+Input: a folder holding one or more results.csv files of ./palcas experiment (FOLDER/*.csv
+and FOLDER/*/results.csv, merged; a point in two files is an error) and optionally
+FOLDER/trial.json naming the settings (the keys of an experiment.json: arms, prs, demands,
+seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, git_commit,
+printed as they are). Without trial.json the grid is what the rows hold.
+
+The page: what was run (failed and missing points named); each arm's mechanisms (the
+registry config/arms.json and the bridge parameters it runs under: config/bridge.yaml, then
+the arm's shipped policies/<arm>/bridge.yaml or its registry bridge_params, then the trial's
+bridge_params); per cell (demand, PR) every arm's mean over seeds with its 95 % Student-t
+interval and its worst seed, CR pooled over the seeds with its exact (Clopper-Pearson)
+interval; each learned arm (advice "network") paired with each control on the seeds both have
+(mean difference, paired bootstrap and paired-t 95 % intervals, worst seed), the best control
+(highest mean speed) first; a reading in plain words generated from those intervals; two
+figures. Deterministic: bootstrap generators seeded by what they compare, stable orders, no
+clock. --check compares the page and every CSV exactly, and that every figure exists (a
+figure's numbers are its CSV; its pixels depend on the matplotlib version)."""
+import argparse
+import csv
+import io
+import json
+import math
+import pathlib
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import palcas_stats  # noqa: E402
+import seed_sets  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+REGISTRY = ROOT / "config" / "arms.json"
+BRIDGE_DEFAULTS = ROOT / "config" / "bridge.yaml"
+RESAMPLES = 10000
+MINUS = "\u2212"
+
+# (key, label, decimals, better): the per-cell table's metrics. better: "higher", "lower" or
+# "neutral" (lane changes: more is more weaving, not a loss by itself). The worst seed is the
+# lowest value of a "higher" metric, the highest of the others. dsr / msr: the censored rates
+# (exit- or merge-bound CAVs still on the road at the end count as not served), else the
+# uncensored dsr_pct / msr_pct of a bridge from before them (marked).
+METRICS = [
+    ("efficiency_all_mps", "Mean speed, all vehicles (m/s)", 2, "higher"),
+    ("efficiency_steady_mps", "Steady-state speed (m/s)", 2, "higher"),
+    ("throughput_vph", "Throughput (veh/h)", 0, "higher"),
+    ("unserved_vehicles", "Unserved vehicles", 1, "lower"),
+    ("total_time_spent_veh_h", "Total time spent (veh·h)", 1, "lower"),
+    ("dsr", "DSR (%)", 1, "higher"),
+    ("msr", "MSR (%)", 1, "higher"),
+    ("lane_changes_per_cav", "Lane changes per CAV", 2, "neutral"),
+    ("comfort_share_pct", "Comfort share (%)", 1, "higher"),
+]
+CENSORED = {"dsr": ("dsr_censored_pct", "dsr_pct"), "msr": ("msr_censored_pct", "msr_pct")}
+# The paired comparisons' metrics (speed also as a ratio).
+PAIRED = ["efficiency_all_mps", "throughput_vph", "unserved_vehicles", "total_time_spent_veh_h",
+          "dsr", "comfort_share_pct", "lane_changes_per_cav"]
+SHORT = {"efficiency_all_mps": "speed", "efficiency_steady_mps": "steady speed", "throughput_vph": "throughput",
+         "unserved_vehicles": "unserved", "total_time_spent_veh_h": "total time spent", "dsr": "DSR",
+         "msr": "MSR", "lane_changes_per_cav": "lane changes per CAV", "comfort_share_pct": "comfort"}
+UNIT = {"efficiency_all_mps": " m/s", "throughput_vph": " veh/h", "unserved_vehicles": " veh",
+        "total_time_spent_veh_h": " veh·h", "dsr": " points", "msr": " points", "comfort_share_pct": " points",
+        "lane_changes_per_cav": ""}
+SPEED = "efficiency_all_mps"
+GUARD_KEYS = ("guard_busy_handback", "guard_busy_lc_assertive", "guard_busy_change_max_accel_mps2",
+              "lane_change_max_accel_mps2")
+
+
+class TrialError(Exception):
+    pass
+
+
+# --- reading -------------------------------------------------------------------------------
+
+def number(v):
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
+def shown_path(path):
+    """A path as the page names it: repository-relative when inside the repository."""
+    path = pathlib.Path(path).resolve()
+    try:
+        return str(path.relative_to(ROOT))
+    except ValueError:
+        return str(path)
+
+
+def input_files(folder, out_dir=None):
+    folder = pathlib.Path(folder)
+    files = sorted(folder.glob("*.csv")) + sorted(folder.glob("*/results.csv"))
+    if out_dir is not None:
+        out = pathlib.Path(out_dir).resolve()
+        files = [f for f in files if out not in f.resolve().parents]
+    return files
+
+
+def read_trial(folder, out_dir=None):
+    """(rows, files, settings): the merged rows (pr, demand, seed as numbers), the CSV files
+    read, and trial.json ({} without one)."""
+    folder = pathlib.Path(folder)
+    if not folder.is_dir():
+        raise TrialError(f"{folder}: no such folder")
+    files = input_files(folder, out_dir)
+    if not files:
+        raise TrialError(f"{folder}: no results.csv (*.csv or */results.csv) in it")
+    settings = {}
+    if (folder / "trial.json").exists():
+        try:
+            settings = json.loads((folder / "trial.json").read_text())
+        except ValueError as e:
+            raise TrialError(f"{folder / 'trial.json'}: not JSON ({e})")
+    rows, seen = [], {}
+    for path in files:
+        with open(path, newline="") as f:
+            for r in csv.DictReader(f):
+                for key in ("arm", "pr", "seed", "status"):
+                    if not r.get(key):
+                        raise TrialError(f"{shown_path(path)}: a row without {key} ({r.get('point', '?')})")
+                r["pr"] = float(r["pr"])
+                r["demand"] = number(r.get("demand"))
+                r["seed"] = int(r["seed"])
+                r["file"] = shown_path(path)
+                key = (r["arm"], r["pr"], r["demand"], r["seed"])
+                if key in seen:
+                    raise TrialError(f"{shown_path(path)}: point {r.get('point', key)} is also in {seen[key]}")
+                seen[key] = r["file"]
+                rows.append(r)
+    return rows, files, settings
+
+
+def load_registry(path=REGISTRY):
+    """config/arms.json as it is (its own checks are tools/palcas_arms.py's)."""
+    return json.loads(pathlib.Path(path).read_text())
+
+
+def advice_of(entry):
+    """network | rules | none: the registry's advice field, else a learning arm (RSUs) is a network."""
+    if entry is None:
+        return "unknown"
+    return entry.get("advice") or ("network" if entry.get("rsus", "none") != "none" else "none")
+
+
+def sort_arms(arms, registry):
+    order = list(registry)
+    return sorted(set(arms), key=lambda a: (order.index(a) if a in registry else len(order), a))
+
+
+def cells_of(rows):
+    cells = sorted({(r["demand"], r["pr"]) for r in rows}, key=lambda c: (c[0] is None, c[0] or 0.0, c[1]))
+    return cells
+
+
+def cell_title(cell):
+    demand, pr = cell
+    d = "the scenario's own demand" if demand is None else f"demand {demand:g} veh/h/lane"
+    return f"{d}, PR {pr:g} %"
+
+
+def cell_short(cell):
+    demand, pr = cell
+    return ("own" if demand is None else f"{demand:g}") + f" / PR {pr:g}"
+
+
+def done_rows(rows, arm, cell):
+    return [r for r in rows if r["arm"] == arm and (r["demand"], r["pr"]) == cell and r["status"] == "done"]
+
+
+def column_for(metric, rows):
+    """The column a metric is read from for these rows, and whether it is the fallback."""
+    if metric not in CENSORED:
+        return metric, False
+    censored, plain = CENSORED[metric]
+    if rows and all(number(r.get(censored)) is not None for r in rows):
+        return censored, False
+    return plain, True
+
+
+# --- bridge parameters and the mechanism table ---------------------------------------------
+
+def read_yaml(path):
+    import yaml
+    data = yaml.safe_load(pathlib.Path(path).read_text())
+    return data if isinstance(data, dict) else {}
+
+
+def resolve_file(name, *bases):
+    p = pathlib.Path(name)
+    if p.is_absolute():
+        return p if p.exists() else None
+    for base in bases:
+        if (base / p).exists():
+            return base / p
+    return None
+
+
+def bridge_params(arm, entry, settings):
+    """(params, sources): the bridge parameters the arm ran under, as the launch layers them
+    (config/bridge.yaml; the shipped policy's bridge.yaml, else the registry's bridge_params;
+    the trial's bridge_params), and the files read, repository-relative."""
+    params, sources = dict(read_yaml(BRIDGE_DEFAULTS)), []
+    policy = (settings.get("policies") or {}).get(arm)
+    policy_yaml = None
+    if policy:
+        d = resolve_file(policy, ROOT)
+        policy_yaml = d / "bridge.yaml" if d and (d / "bridge.yaml").exists() else None
+    elif entry.get("shipped_policy") and (ROOT / "policies" / arm / "bridge.yaml").exists():
+        policy_yaml = ROOT / "policies" / arm / "bridge.yaml"
+    if policy_yaml is None and entry.get("bridge_params"):
+        policy_yaml = resolve_file(entry["bridge_params"], ROOT / "config", ROOT)
+        if policy_yaml is None:
+            raise TrialError(f"arm '{arm}': its registry bridge_params {entry['bridge_params']} is not under config/")
+    for f in (policy_yaml, resolve_file(settings["bridge_params"], ROOT) if settings.get("bridge_params") else None):
+        if f is not None:
+            params.update(read_yaml(f))
+            sources.append(shown_path(f))
+    if settings.get("bridge_params") and len(sources) < 1 + (policy_yaml is not None):
+        raise TrialError(f"trial.json: bridge_params {settings['bridge_params']} is not in the repository")
+    return params, sources
+
+
+def yes(flag):
+    return "yes" if flag else "no"
+
+
+def accel_text(v):
+    v = number(v) or 0.0
+    return f"{v:g} m/s²" if v > 0 else "off"
+
+
+ADVICE_WORDS = {"network": "learned network", "rules": "rule", "none": "none", "unknown": "?"}
+MECHANISM_HEAD = ["arm", "title", "RSUs", "advice", "federation", "I2I", "advisory control",
+                  "assist mode", "busy-zone hand-back", "busy-zone gap acceptance",
+                  "busy-zone change bound", "advised-change accel. bound", "bridge files over config/bridge.yaml"]
+
+
+def mechanism_rows(arms, registry, settings):
+    """One row of MECHANISM_HEAD per arm (registry order); the guard columns are '—' for an
+    arm without advisory control (SUMO's own models: nothing of the bridge's guard applies)."""
+    out = []
+    for arm in sort_arms(arms, registry):
+        entry = registry.get(arm)
+        if entry is None:
+            out.append([arm, "(not in config/arms.json)"] + ["?"] * (len(MECHANISM_HEAD) - 2))
+            continue
+        params, sources = bridge_params(arm, entry, settings)
+        row = [arm, entry.get("title", arm), entry.get("rsus", "?"), ADVICE_WORDS[advice_of(entry)],
+               yes(entry.get("federation")), yes(entry.get("i2i")), yes(entry.get("advisory_control")),
+               yes(entry.get("assist_mode"))]
+        if entry.get("advisory_control"):
+            lc = number(params.get("guard_busy_lc_assertive")) or 0.0
+            row += ["on" if params.get("guard_busy_handback") else "off",
+                    f"lcAssertive {lc:.1f}" if lc > 0 else "off",
+                    accel_text(params.get("guard_busy_change_max_accel_mps2")),
+                    accel_text(params.get("lane_change_max_accel_mps2"))]
+        else:
+            row += ["—"] * 4
+        row.append(", ".join(sources) if sources else "none")
+        out.append(row)
+    return out
+
+
+# --- statistics per cell and per pair ------------------------------------------------------
+
+def summary(values_by_seed, better):
+    """{n, mean, lo, hi, worst, worst_seed} of [(seed, value)] (seed order)."""
+    vals = [v for _, v in values_by_seed]
+    mean, lo, hi = palcas_stats.t_interval(vals)
+    pick = min if better == "higher" else max
+    worst_seed, worst = pick(values_by_seed, key=lambda sv: (sv[1], sv[0]) if pick is min else (sv[1], -sv[0]))
+    return {"n": len(vals), "mean": mean, "lo": lo, "hi": hi, "worst": worst, "worst_seed": worst_seed}
+
+
+def arm_cell(rows, arm, cell):
+    """Every metric's summary for one arm in one cell, the pooled CR and decision p99."""
+    sel = sorted(done_rows(rows, arm, cell), key=lambda r: r["seed"])
+    out = {"n": len(sel), "seeds": [r["seed"] for r in sel], "metrics": {}}
+    for key, _, _, better in METRICS:
+        column, fallback = column_for(key, sel)
+        vals = [(r["seed"], number(r.get(column))) for r in sel if number(r.get(column)) is not None]
+        if vals:
+            out["metrics"][key] = dict(summary(vals, better), column=column, fallback=fallback)
+    k = n = 0
+    derived = False
+    for r in sel:
+        seen = number(r.get("cavs_seen"))
+        hit = number(r.get("cav_collisions"))
+        if hit is None and seen is not None and number(r.get("collision_rate_pct")) is not None:
+            hit, derived = round(number(r["collision_rate_pct"]) * seen / 100.0), True
+        if seen is None or hit is None:
+            continue
+        k, n = k + int(round(hit)), n + int(round(seen))
+    if n > 0:
+        lo, hi = palcas_stats.clopper_pearson(k, n)
+        out["cr"] = {"k": k, "n": n, "pct": 100.0 * k / n, "lo": 100.0 * lo, "hi": 100.0 * hi, "derived": derived}
+    p99 = [(r["seed"], number(r.get("decision_ms_p99"))) for r in sel if number(r.get("decision_ms_p99")) is not None]
+    if p99:
+        seed, worst = max(p99, key=lambda sv: (sv[1], -sv[0]))
+        out["p99"] = {"max": worst, "seed": seed}
+    return out
+
+
+def pair(rows, learned, control, cell, metric, seeds=None):
+    """(pairs, left_out): pairs [(seed, learned value, control value)] of the seeds where both
+    arms finished with a value of the metric (dsr/msr: censored when both have it on every
+    paired seed, else both uncensored), and left_out [(seed, reason)] for every other seed of
+    the cell (or of `seeds`, the trial's list)."""
+    by = {}
+    for arm in (learned, control):
+        by[arm] = {r["seed"]: r for r in rows if r["arm"] == arm and (r["demand"], r["pr"]) == cell}
+    universe = sorted(set(seeds) if seeds else set(by[learned]) | set(by[control]))
+    both_done = [s for s in universe if all(s in by[a] and by[a][s]["status"] == "done" for a in by)]
+    column, fallback = column_for(metric, [by[a][s] for a in by for s in both_done])
+    pairs, left_out = [], []
+    for s in universe:
+        why = []
+        for arm in (learned, control):
+            r = by[arm].get(s)
+            if r is None:
+                why.append(f"{arm}: no row")
+            elif r["status"] != "done":
+                why.append(f"{arm}: {r['status']}")
+            elif number(r.get(column)) is None:
+                why.append(f"{arm}: no {column}")
+        if why:
+            left_out.append((s, "; ".join(why)))
+        else:
+            pairs.append((s, number(by[learned][s][column]), number(by[control][s][column])))
+    return pairs, left_out, column, fallback
+
+
+def compare(rows, learned, control, cell, metric, seeds=None, ratio=False):
+    """The paired comparison of one metric: mean difference (or mean per-seed ratio, as a
+    percentage change, with ratio=True), its bootstrap and paired-t intervals, the worst seed."""
+    pairs, left_out, column, fallback = pair(rows, learned, control, cell, metric, seeds)
+    better = dict((k, b) for k, _, _, b in METRICS)[metric]
+    if ratio:
+        per = [(s, 100.0 * (a / b - 1.0)) for s, a, b in pairs if b]
+        left_out += [(s, f"{control}: zero {column}") for s, a, b in pairs if not b]
+    else:
+        per = [(s, a - b) for s, a, b in pairs]
+    out = {"learned": learned, "control": control, "cell": cell, "metric": metric, "ratio": ratio,
+           "column": column, "fallback": fallback, "pairs": pairs, "per_seed": per,
+           "left_out": sorted(left_out), "n": len(per), "better": better}
+    if not per:
+        return out
+    d = [v for _, v in per]
+    mean, t_lo, t_hi = palcas_stats.t_interval(d)
+    b_lo, b_hi = palcas_stats.bootstrap_mean_ci(
+        d, palcas_stats.stable_seed(cell[0], cell[1], learned, control, metric, ratio), RESAMPLES)
+    worst = summary(per, better)
+    worst_seed, worst = worst["worst_seed"], worst["worst"]
+    out.update(mean=mean, t_lo=t_lo, t_hi=t_hi, b_lo=b_lo, b_hi=b_hi, worst=worst, worst_seed=worst_seed,
+               learned_mean=sum(a for _, a, _ in pairs) / len(pairs),
+               control_mean=sum(b for _, _, b in pairs) / len(pairs))
+    return out
+
+
+def verdict(c):
+    """gain / loss / more / fewer / none, from the span of both intervals (the paired-t one
+    and the bootstrap one): the whole span above 0 or below 0, else no difference shown."""
+    if c["n"] < 2 or not math.isfinite(c["t_lo"]):
+        return "none"
+    lo, hi = min(c["t_lo"], c["b_lo"]), max(c["t_hi"], c["b_hi"])
+    if lo > 0:
+        side = "up"
+    elif hi < 0:
+        side = "down"
+    else:
+        return "none"
+    if c["better"] == "neutral":
+        return "more" if side == "up" else "fewer"
+    good = (side == "up") == (c["better"] == "higher")
+    return "gain" if good else "loss"
+
+
+def span(c):
+    return min(c["t_lo"], c["b_lo"]), max(c["t_hi"], c["b_hi"])
+
+
+def trial_grid(rows, settings, registry):
+    arms = sort_arms(settings.get("arms") or {r["arm"] for r in rows}, registry)
+    seeds = sorted(settings.get("seeds") or {r["seed"] for r in rows})
+    if settings.get("prs"):
+        demands = settings.get("demands") or sorted({r["demand"] for r in rows}, key=lambda d: (d is None, d or 0))
+        cells = sorted({(number(d) if d is not None else None, float(p)) for d in demands for p in settings["prs"]},
+                       key=lambda c: (c[0] is None, c[0] or 0.0, c[1]))
+    else:
+        cells = cells_of(rows)
+    return arms, seeds, cells
+
+
+def in_grid(rows, settings, registry):
+    """(rows in the trial's grid, rows outside it): trial.json's arms, seeds and cells when it
+    names them."""
+    arms, seeds, cells = trial_grid(rows, settings, registry)
+    inside = [r for r in rows if r["arm"] in arms and r["seed"] in seeds and (r["demand"], r["pr"]) in cells]
+    return inside, [r for r in rows if r not in inside]
+
+
+def analyse(rows, settings, registry):
+    """Everything the page shows, as numbers (rows outside the trial's grid left out)."""
+    arms, seeds, cells = trial_grid(rows, settings, registry)
+    rows = in_grid(rows, settings, registry)[0]
+    present = sort_arms({r["arm"] for r in rows}, registry)
+    learned = [a for a in present if advice_of(registry.get(a)) == "network"]
+    controls = [a for a in present if advice_of(registry.get(a)) not in ("network", "unknown")]
+    result = {"arms": present, "seeds": seeds, "cells": [], "learned": learned, "controls": controls}
+    for cell in cells:
+        per_arm = {a: arm_cell(rows, a, cell) for a in present}
+        speeds = {a: per_arm[a]["metrics"][SPEED]["mean"] for a in controls if SPEED in per_arm[a]["metrics"]}
+        best = max(speeds, key=lambda a: (speeds[a], -controls.index(a))) if speeds else None
+        # Every learned arm against the best control first, then against the others.
+        order = [(L, best) for L in learned if best] + [(L, C) for L in learned for C in controls if C != best]
+        comparisons = []
+        for L, C in order:
+            if not (per_arm[L]["n"] and per_arm[C]["n"]):
+                continue
+            comparisons.append({"learned": L, "control": C, "best": C == best,
+                                "ratio": compare(rows, L, C, cell, SPEED, seeds, ratio=True),
+                                "metrics": [compare(rows, L, C, cell, m, seeds) for m in PAIRED]})
+        result["cells"].append({"cell": cell, "arms": per_arm, "best": best, "best_speed": speeds.get(best),
+                                "comparisons": comparisons})
+    return result
+
+
+# --- formatting ----------------------------------------------------------------------------
+
+def fmt(v, digits, signed=False):
+    if v is None or not math.isfinite(v):
+        return "n/a"
+    text = f"{v:+.{digits}f}" if signed else f"{v:.{digits}f}"
+    if float(text) == 0.0:  # no "-0.0" / "+0.0"
+        text = f"{0.0:.{digits}f}"
+    return text.replace("-", MINUS)
+
+
+def fmt_bound(v, digits, signed=False):
+    """An interval's bound: with up to 3 more decimals when it would print as 0 but is not,
+    so that a bound's side of 0 (what the reading turns on) shows."""
+    for d in range(digits, digits + 4):
+        text = fmt(v, d, signed)
+        if not math.isfinite(v) or v == 0.0 or float(text.replace(MINUS, "-")) != 0.0:
+            return text
+    return text
+
+
+def interval(lo, hi, digits):
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return "n/a (one seed)"
+    return f"[{fmt_bound(lo, digits)}, {fmt_bound(hi, digits)}]"
+
+
+def digits_of(metric):
+    return dict((k, d) for k, _, d, _ in METRICS)[metric]
+
+
+def label_of(metric):
+    return dict((k, l) for k, l, _, _ in METRICS)[metric]
+
+
+def seed_list(seeds):
+    return seed_sets.describe(sorted(seeds)) if seeds else "none"
+
+
+def md_table(head, rows):
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return lines
+
+
+def csv_text(head, rows):
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(head)
+    for r in rows:
+        w.writerow(["" if v is None else (f"{v + 0.0:.6g}" if isinstance(v, float) else v) for v in r])
+    return buf.getvalue()
+
+
+def what_was_run(rows, files, settings, folder, a):
+    seeds = a["seeds"]
+    name = settings.get("seed_set") or seed_sets.set_of(seeds)
+    arms = sort_arms(settings.get("arms") or a["arms"], load_registry())
+    durations = sorted({number(r.get("sim_seconds")) for r in rows if r["status"] == "done"} - {None})
+    if settings.get("duration_s"):
+        duration = f"{float(settings['duration_s']):g} s per point"
+    elif len(durations) == 1:
+        duration = f"{durations[0]:g} s per point (the rows' sim_seconds; no trial.json)"
+    else:
+        duration = "not recorded"
+    demands = sorted({c[0] for c in (x["cell"] for x in a["cells"])}, key=lambda d: (d is None, d or 0))
+    prs = sorted({c[1] for c in (x["cell"] for x in a["cells"])})
+    lines = ["## What was run", ""]
+    lines.append(f"- Input: {', '.join(f'`{shown_path(f)}`' for f in files)}"
+                 + (f"; settings: `{shown_path(pathlib.Path(folder) / 'trial.json')}`" if settings else
+                    " (no trial.json: the grid is what the rows hold)"))
+    for key in ("note", "date", "git_commit"):
+        if settings.get(key):
+            lines.append(f"- {key.replace('_', ' ')}: {settings[key]}")
+    lines.append(f"- Road: `{settings.get('scenario', 'not recorded')}`; duration: {duration}")
+    lines.append("- Demands (veh/h per lane): " + ", ".join("the scenario's own" if d is None else f"{d:g}"
+                                                           for d in demands))
+    lines.append("- PRs (%): " + ", ".join(f"{p:g}" for p in prs))
+    lines.append("- Arms: " + ", ".join(f"`{x}`" for x in arms))
+    set_text = (f"set `{name}` of config/seeds.yaml" if name else "in no one set of config/seeds.yaml")
+    if name == "dev":
+        set_text += " (**development seeds: settings were chosen on them; not a held-out result**)"
+    lines.append(f"- Seeds ({len(seeds)}, {set_text}): {', '.join(str(s) for s in seeds)}")
+    if settings.get("bridge_params"):
+        lines.append(f"- Every point under the bridge override `{settings['bridge_params']}`")
+    expected = [(arm, c, s) for arm in arms for c in (x["cell"] for x in a["cells"]) for s in seeds]
+    have = {(r["arm"], (r["demand"], r["pr"]), r["seed"]): r for r in rows}
+    done = sum(1 for k in expected if k in have and have[k]["status"] == "done")
+    extra = in_grid(rows, settings, load_registry())[1]
+    lines.append(f"- Points: {len(expected)} planned ({len(arms)} arms × {len(a['cells'])} cells × "
+                 f"{len(seeds)} seeds), {done} finished")
+    bad = []
+    for arm, cell, seed in expected:
+        r = have.get((arm, cell, seed))
+        if r is None:
+            bad.append(f"`{arm}` {cell_short(cell)} s{seed}: missing (no row)")
+        elif r["status"] != "done":
+            err = (r.get("error") or "").strip()
+            bad.append(f"`{arm}` {cell_short(cell)} s{seed}: {r['status']}" + (f" ({err})" if err else ""))
+    lines.append("- Failed or missing points: " + ("none" if not bad else str(len(bad))))
+    lines += [f"  - {b}" for b in bad]
+    if extra:
+        lines.append(f"- Rows outside the planned grid, not in the tables: "
+                     + ", ".join(f"{r.get('point') or r['arm']}" for r in extra))
+    return lines
+
+
+def mechanism_section(a, registry, settings):
+    lines = ["", "## The arms and their mechanisms", "",
+             "From `config/arms.json` and the bridge parameters each arm runs under. *advisory "
+             "control*: the CAVs carry out the advice and make no lane changes of their own outside "
+             "busy zones; *assist mode*: the CAVs keep their own route-aware lane changing and advice "
+             "comes on top. The four guard columns are the bridge's (`config/bridge.yaml`: "
+             "`guard_busy_handback`, `guard_busy_lc_assertive`, `guard_busy_change_max_accel_mps2`, "
+             "`lane_change_max_accel_mps2`; a later file overrides an earlier one) and act on every "
+             "arm with advisory control; an arm without it (SUMO's own models) has none of them (—). "
+             "Learned arms (advice from a network) are compared below with the others (the controls).", ""]
+    lines += md_table(MECHANISM_HEAD, [[f"`{r[0]}`"] + r[1:] for r in mechanism_rows(a["arms"], registry, settings)])
+    return lines
+
+
+def cell_value_text(m, digits):
+    text = f"{fmt(m['mean'], digits)} ± {fmt((m['hi'] - m['lo']) / 2.0, digits)}" if math.isfinite(m["lo"]) \
+        else fmt(m["mean"], digits)
+    text += f" (worst {fmt(m['worst'], digits)}, s{m['worst_seed']})"
+    return text + (" †" if m.get("fallback") else "")
+
+
+def per_cell_section(a):
+    lines = ["", "## Each arm, per cell", "",
+             "Mean over the finished seeds ± half-width of the two-sided 95 % Student-t interval, and "
+             "the worst seed (the lowest value; for unserved vehicles, time spent and lane changes the "
+             "highest). DSR and MSR count the exit- and merge-bound CAVs still on the road at the end "
+             "as not served (`dsr_censored_pct`, `msr_censored_pct`); † marks the uncensored rate of a "
+             "bridge from before them (`dsr_pct`, `msr_pct`). CR is pooled over the seeds (CAVs that "
+             "collided ÷ CAVs seen) with its exact Clopper–Pearson 95 % interval; decision p99 is the "
+             "largest over the seeds."]
+    fell_back = False
+    for x in a["cells"]:
+        arms = [arm for arm in a["arms"] if x["arms"][arm]["n"]]
+        lines += ["", f"### {cell_title(x['cell'])}", ""]
+        if not arms:
+            lines.append("No finished point.")
+            continue
+        body = [["seeds finished"] + [str(x["arms"][arm]["n"]) for arm in arms]]
+        for key, label, digits, _ in METRICS:
+            cells = []
+            for arm in arms:
+                m = x["arms"][arm]["metrics"].get(key)
+                fell_back |= bool(m and m.get("fallback"))
+                cells.append(cell_value_text(m, digits) if m else "n/a")
+            body.append([label] + cells)
+        cr = []
+        for arm in arms:
+            c = x["arms"][arm].get("cr")
+            cr.append("n/a" if not c else f"{fmt(c['pct'], 3)} [{fmt(c['lo'], 3)}, {fmt(c['hi'], 3)}] "
+                      f"({c['k']} of {c['n']} CAVs{', from collision_rate_pct' if c['derived'] else ''})")
+        body.append(["CR, pooled (%)"] + cr)
+        body.append(["Decision p99, max (ms)"] + [
+            f"{fmt(x['arms'][arm]['p99']['max'], 1)} (s{x['arms'][arm]['p99']['seed']})" if "p99" in x["arms"][arm]
+            else "—" for arm in arms])
+        lines += md_table(["metric"] + [f"`{arm}`" for arm in arms], body)
+    if fell_back:
+        lines += ["", "† uncensored (`dsr_pct` / `msr_pct`): these runs' bridge did not yet write the censored rate."]
+    return lines
+
+
+def diff_text(c, digits):
+    if c["n"] == 0:
+        return ["0", "n/a", "n/a", "n/a", "n/a", "n/a", "n/a", "n/a"]
+    unit = " %" if c["ratio"] else ""
+    lo, hi = span(c) if math.isfinite(c["t_lo"]) else (float("nan"), float("nan"))
+    return [str(c["n"]), fmt(c["learned_mean"], digits_of(c["metric"])), fmt(c["control_mean"], digits_of(c["metric"])),
+            fmt(c["mean"], digits, signed=True) + unit, interval(c["b_lo"], c["b_hi"], digits),
+            interval(c["t_lo"], c["t_hi"], digits), f"{fmt(c['worst'], digits, signed=True)}{unit} (s{c['worst_seed']})",
+            WORDS[verdict(c)] if math.isfinite(lo) else "one seed: none shown"]
+
+
+WORDS = {"gain": "a gain", "loss": "a loss", "none": "no difference shown", "more": "more", "fewer": "fewer"}
+PAIR_HEAD = ["learned vs control", "metric", "seeds", "learned", "control", "mean difference",
+             "bootstrap 95 %", "paired-t 95 %", "worst seed", "reading"]
+
+
+def paired_section(a):
+    lines = ["", "## Learned arms against the controls, paired by seed", "",
+             f"Each learned arm (advice from a network: {', '.join(f'`{x}`' for x in a['learned']) or 'none here'}) "
+             f"against each control ({', '.join(f'`{x}`' for x in a['controls']) or 'none here'}) on the seeds "
+             "both finished: the mean of the per-seed differences (learned − control; speed also as the "
+             f"per-seed ratio learned ÷ control − 1, in %), its paired bootstrap interval ({RESAMPLES} "
+             "resamples of the seeds, percentile, seeded by the comparison's name) and its paired-t "
+             "interval, and the seed least favourable to the learned arm. The best control of a cell is "
+             "the control with the highest mean speed there; its rows come first. Reading: *a gain* or "
+             "*a loss* when both intervals lie entirely on one side of 0, else *no difference shown* "
+             "(for lane changes: *more* / *fewer*). A seed without a pair is named under the table."]
+    if not a["learned"] or not a["controls"]:
+        lines += ["", "No pair to compare: the trial needs a learned arm and a control."]
+        return lines
+    for x in a["cells"]:
+        best = x["best"]
+        lines += ["", f"### {cell_title(x['cell'])}", "",
+                  f"Best control: `{best}` ({fmt(x['best_speed'], 2)} m/s)." if best else "No control finished here."]
+        body, notes = [], []
+        for e in x["comparisons"]:
+            name = f"`{e['learned']}` vs `{e['control']}`" + (" (best)" if e["best"] else "")
+            body.append([name, "speed ratio − 1"] + diff_text(e["ratio"], 2))
+            for c in e["metrics"]:
+                if not e["best"] and c["metric"] != SPEED:
+                    continue
+                label = SHORT[c["metric"]] + (" †" if c["fallback"] else "")
+                body.append([name, label] + diff_text(c, digits_of(c["metric"])))
+            left = e["ratio"]["left_out"]
+            if left:
+                notes.append(f"- `{e['learned']}` vs `{e['control']}`: seeds left out: "
+                             + "; ".join(f"s{s} ({why})" for s, why in left))
+        if body:
+            lines += [""] + md_table(PAIR_HEAD, body)
+            lines += ([""] + notes) if notes else []
+    lines += ["", "Against a control that is not the cell's best, only speed is shown here; every metric "
+              "of every pair is in `results/paired.csv`."]
+    return lines
+
+
+def reading_line(c, pct=False):
+    name = "speed" if pct else SHORT[c["metric"]]
+    if c["n"] == 0:
+        return f"{name}: no paired seed"
+    d = 1 if pct else digits_of(c["metric"])
+    unit = " %" if pct else UNIT[c["metric"]]
+    if c["n"] < 2:
+        return f"{name} {fmt(c['mean'], d, signed=True)}{unit} on one seed: no difference shown"
+    lo, hi = span(c)
+    return (f"{name} {fmt(c['mean'], d, signed=True)}{unit} [{fmt_bound(lo, d, True)}, {fmt_bound(hi, d, True)}], "
+            f"worst seed {fmt(c['worst'], d, signed=True)}{unit}: {WORDS[verdict(c)]}")
+
+
+def reading_section(a):
+    lines = ["", "## Reading", "",
+             "Generated from the intervals above, nothing else: *a gain* / *a loss* when the whole span "
+             "of the two 95 % intervals (bootstrap and paired t) lies above / below 0 in the learned "
+             "arm's favour / against it, else *no difference shown*; the bracket is that span."]
+    for x in a["cells"]:
+        lines += ["", f"**{cell_title(x['cell'])}**", ""]
+        if not x["comparisons"]:
+            lines.append("- nothing to compare")
+            continue
+        for e in x["comparisons"]:
+            n = e["ratio"]["n"]
+            if e["best"]:
+                lines.append(f"- `{e['learned']}` vs best control ({e['control']}), {n} paired seeds: "
+                             + reading_line(e["ratio"], pct=True))
+                for c in e["metrics"]:
+                    if c["metric"] != SPEED:
+                        lines.append(f"  - {reading_line(c)}")
+            else:
+                lines.append(f"- `{e['learned']}` vs {e['control']}, {n} paired seeds: " + reading_line(e["ratio"], pct=True))
+    return lines
+
+
+# --- CSVs and figures ----------------------------------------------------------------------
+
+def cells_csv(a):
+    rows = []
+    for x in a["cells"]:
+        d, pr = x["cell"]
+        for arm in a["arms"]:
+            ac = x["arms"][arm]
+            for key, _, _, _ in METRICS:
+                m = ac["metrics"].get(key)
+                if m:
+                    rows.append([d, pr, arm, key, m["column"], m["n"], m["mean"], m["lo"], m["hi"], m["worst"],
+                                 m["worst_seed"]])
+            if "cr" in ac:
+                c = ac["cr"]
+                rows.append([d, pr, arm, "cr_pooled_pct", "cav_collisions/cavs_seen", ac["n"], c["pct"], c["lo"],
+                             c["hi"], f"{c['k']} of {c['n']}", ""])
+            if "p99" in ac:
+                rows.append([d, pr, arm, "decision_ms_p99_max", "decision_ms_p99", ac["n"], ac["p99"]["max"], "", "",
+                             ac["p99"]["max"], ac["p99"]["seed"]])
+    return csv_text(["demand", "pr", "arm", "metric", "column", "n", "mean", "ci95_lo", "ci95_hi", "worst",
+                     "worst_seed"], rows)
+
+
+def comparisons(a):
+    for x in a["cells"]:
+        for e in x["comparisons"]:
+            for c in [e["ratio"]] + e["metrics"]:
+                yield x, e, c
+
+
+def paired_csv(a):
+    rows = []
+    for x, e, c in comparisons(a):
+        d, pr = x["cell"]
+        metric = "speed_ratio_pct" if c["ratio"] else c["metric"]
+        if c["n"]:
+            rows.append([d, pr, e["learned"], e["control"], "yes" if e["best"] else "no", metric, c["column"], c["n"],
+                         c["mean"], c["b_lo"], c["b_hi"], c["t_lo"], c["t_hi"], c["worst"], c["worst_seed"], verdict(c),
+                         " ".join(f"s{s}" for s, _ in c["left_out"])])
+        else:
+            rows.append([d, pr, e["learned"], e["control"], "yes" if e["best"] else "no", metric, c["column"], 0,
+                         None, None, None, None, None, None, None, "none", " ".join(f"s{s}" for s, _ in c["left_out"])])
+    return csv_text(["demand", "pr", "learned", "control", "best_control", "metric", "column", "n", "mean_diff",
+                     "bootstrap_lo", "bootstrap_hi", "t_lo", "t_hi", "worst_diff", "worst_seed", "reading",
+                     "seeds_left_out"], rows)
+
+
+def paired_seeds_csv(a):
+    rows = []
+    for x, e, c in comparisons(a):
+        if not e["best"]:
+            continue
+        d, pr = x["cell"]
+        metric = "speed_ratio_pct" if c["ratio"] else c["metric"]
+        for (s, lv, cv), (_, diff) in zip([p for p in c["pairs"] if not c["ratio"] or p[2]], c["per_seed"]):
+            rows.append([d, pr, e["learned"], e["control"], metric, s, lv, cv, diff])
+    return csv_text(["demand", "pr", "learned", "control", "metric", "seed", "learned_value", "control_value",
+                     "difference"], rows)
+
+
+def speed_ratio_csv(a):
+    rows = []
+    for x, e, c in comparisons(a):
+        if e["best"] and c["ratio"] and c["n"]:
+            lo, hi = span(c) if math.isfinite(c["t_lo"]) else (None, None)
+            rows.append([x["cell"][0], x["cell"][1], e["learned"], e["control"], c["n"], 1.0 + c["mean"] / 100.0,
+                         None if lo is None else 1.0 + lo / 100.0, None if hi is None else 1.0 + hi / 100.0,
+                         1.0 + c["worst"] / 100.0, c["worst_seed"]])
+    return csv_text(["demand", "pr", "learned", "best_control", "n", "ratio_mean", "ratio_lo", "ratio_hi",
+                     "ratio_worst", "worst_seed"], rows)
+
+
+def draw_speed_ratio(a, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cells = [x["cell"] for x in a["cells"]]
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(cells) + 2), 4.2))
+    width = 0.8 / max(1, len(a["learned"]))
+    for i, L in enumerate(a["learned"]):
+        xs, ys, lo, hi = [], [], [], []
+        for j, x in enumerate(a["cells"]):
+            for e in x["comparisons"]:
+                c = e["ratio"]
+                if e["best"] and e["learned"] == L and c["n"]:
+                    lo_, hi_ = span(c) if math.isfinite(c["t_lo"]) else (c["mean"], c["mean"])
+                    m = 1.0 + c["mean"] / 100.0
+                    xs.append(j - 0.4 + width * (i + 0.5))
+                    ys.append(m)
+                    lo.append(m - (1.0 + lo_ / 100.0))
+                    hi.append((1.0 + hi_ / 100.0) - m)
+        if xs:
+            ax.errorbar(xs, ys, yerr=[lo, hi], fmt="o", capsize=4, color=f"C{i % 10}", label=L)
+    ax.axhline(1.0, color="0.4", lw=1, ls="--")
+    ax.set_xticks(range(len(cells)))
+    ax.set_xticklabels([f"{cell_short(c)}\nvs {x['best'] or '-'}" for c, x in zip(cells, a["cells"])], fontsize=8)
+    ax.set_xlabel("demand (veh/h/lane) / PR (%), best control")
+    ax.set_ylabel("mean speed ÷ best control's (same seeds)")
+    ax.set_title("Learned arm's speed relative to the best control\n(95 % interval: span of paired t and bootstrap)")
+    ax.grid(alpha=0.3)
+    if a["learned"]:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90, metadata={"Software": None})
+    plt.close(fig)
+
+
+def draw_paired_seeds(a, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    panels = [("speed", None)] + [(SHORT[m], m) for m in PAIRED if m != SPEED]
+    cols = 4
+    nrows = math.ceil(len(panels) / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(4.0 * cols, 3.4 * nrows), squeeze=False)
+    width = 0.8 / max(1, len(a["learned"]))
+    for p, (label, metric) in enumerate(panels):
+        ax = axes[p // cols][p % cols]
+        for i, L in enumerate(a["learned"]):
+            for j, x in enumerate(a["cells"]):
+                for e in x["comparisons"]:
+                    if not e["best"] or e["learned"] != L:
+                        continue
+                    c = e["ratio"] if metric is None else next(m for m in e["metrics"] if m["metric"] == metric)
+                    if not c["n"]:
+                        continue
+                    x0 = j - 0.4 + width * (i + 0.5)
+                    vals = [v for _, v in c["per_seed"]]
+                    offs = [(k - (len(vals) - 1) / 2.0) * min(0.6 * width / max(1, len(vals)), 0.05)
+                            for k in range(len(vals))]
+                    ax.scatter([x0 + o for o in offs], vals, s=12, color=f"C{i % 10}",
+                               label=None if L in ax.get_legend_handles_labels()[1] else L)
+                    ax.hlines(c["mean"], x0 - width * 0.4, x0 + width * 0.4, color=f"C{i % 10}", lw=2)
+        ax.axhline(0.0, color="0.4", lw=1, ls="--")
+        ax.set_xticks(range(len(a["cells"])))
+        ax.set_xticklabels([cell_short(x["cell"]) for x in a["cells"]], fontsize=7)
+        ax.set_title(f"{label}: learned − best control" + (" (%)" if metric is None else ""), fontsize=9)
+        ax.grid(alpha=0.3)
+    for p in range(len(panels), nrows * cols):
+        axes[p // cols][p % cols].axis("off")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="lower right", fontsize=8)
+    fig.suptitle("Per-seed paired differences against each cell's best control (bar: mean)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80, metadata={"Software": None})
+    plt.close(fig)
+
+
+FIGURES = [("speed_ratio.png", draw_speed_ratio, "speed ratio to the best control per cell, per learned arm, "
+            "with the span of the two 95 % intervals (`results/speed_ratio.csv`)"),
+           ("paired_seeds.png", draw_paired_seeds, "every seed's paired difference against the cell's best "
+            "control, per metric (`results/paired_seeds.csv`)")]
+
+
+# --- the page ------------------------------------------------------------------------------
+
+def command_line(folder, out_dir):
+    cmd = f"/usr/bin/python3 tools/trial_results.py {shown_path(folder)}"
+    if pathlib.Path(out_dir).resolve() != (ROOT / "docs").resolve():
+        cmd += f" --out {shown_path(out_dir)}"
+    return cmd
+
+
+def generate(folder, out_dir):
+    """{relative path: text} of the page and its CSVs, and the analysis (for the figures)."""
+    rows, files, settings = read_trial(folder, out_dir)
+    registry = load_registry()
+    a = analyse(rows, settings, registry)
+    page = ["# Results of the fair trial", "",
+            f"<!-- Generated by tools/trial_results.py from {shown_path(folder)}; do not edit: run "
+            f"`{command_line(folder, out_dir)}` (`--check` tells whether this page is current). -->", "",
+            "Learned arms against non-learned controls on the same seeds, demands and PRs. Every number "
+            "and every word of judgement on this page is computed from the trial's rows by the generator."]
+    page += [""] + what_was_run(rows, files, settings, folder, a)
+    page += mechanism_section(a, registry, settings)
+    page += per_cell_section(a)
+    page += paired_section(a)
+    page += reading_section(a)
+    page += ["", "## Figures", ""]
+    for name, _, what in FIGURES:
+        page += [f"![{name}](results/{name})", "", f"{what}.", ""]
+    page += ["CSVs in `results/`: `cells.csv` (every arm's numbers per cell), `paired.csv` (every "
+             "comparison), `paired_seeds.csv` and `speed_ratio.csv` (the figures' numbers)."]
+    texts = {"RESULTS.md": "\n".join(page) + "\n", "results/cells.csv": cells_csv(a),
+             "results/paired.csv": paired_csv(a), "results/paired_seeds.csv": paired_seeds_csv(a),
+             "results/speed_ratio.csv": speed_ratio_csv(a)}
+    return texts, a
+
+
+def write(folder, out_dir):
+    out_dir = pathlib.Path(out_dir)
+    texts, a = generate(folder, out_dir)
+    (out_dir / "results").mkdir(parents=True, exist_ok=True)
+    wanted = set(texts) | {f"results/{n}" for n, _, _ in FIGURES}
+    for old in sorted((out_dir / "results").glob("*")):
+        if old.suffix in (".csv", ".png") and f"results/{old.name}" not in wanted:
+            old.unlink()
+    for rel, text in texts.items():
+        (out_dir / rel).write_text(text)
+    for name, draw, _ in FIGURES:
+        draw(a, out_dir / "results" / name)
+    return sorted(wanted)
+
+
+def check(folder, out_dir):
+    """None when the committed page and CSVs are what the folder gives (and every figure
+    exists), else the first difference, in words."""
+    out_dir = pathlib.Path(out_dir)
+    texts, _ = generate(folder, out_dir)
+    for rel in sorted(texts, key=lambda r: (r != "RESULTS.md", r)):
+        f = out_dir / rel
+        if not f.exists():
+            return f"{shown_path(f)} is missing"
+        have, want = f.read_text().splitlines(), texts[rel].splitlines()
+        for i, (h, w) in enumerate(zip(have, want)):
+            if h != w:
+                return f"{shown_path(f)} line {i + 1} differs:\n  committed:   {h}\n  regenerated: {w}"
+        if len(have) != len(want):
+            i = min(len(have), len(want))
+            return (f"{shown_path(f)} has {len(have)} lines, regenerated {len(want)}; first extra line "
+                    f"{i + 1}: {(have if len(have) > len(want) else want)[i]}")
+    for name, _, _ in FIGURES:
+        if not (out_dir / "results" / name).exists():
+            return f"{shown_path(out_dir / 'results' / name)} is missing"
+    wanted = {pathlib.PurePath(r).name for r in texts} | {n for n, _, _ in FIGURES}
+    for f in sorted((out_dir / "results").glob("*")):
+        if f.suffix in (".csv", ".png") and f.name not in wanted:
+            return f"{shown_path(f)} is not generated by the trial (a stale file)"
+    return None
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("folder", help="the trial's results: *.csv (results.csv of ./palcas experiment) and trial.json")
+    ap.add_argument("--out", default=str(ROOT / "docs"), help="RESULTS.md and results/ go here (default docs)")
+    ap.add_argument("--check", action="store_true", help="compare with the committed page; write nothing")
+    a = ap.parse_args(argv)
+    try:
+        if a.check:
+            diff = check(a.folder, a.out)
+            if diff:
+                print(f"trial_results --check: {diff}\n(regenerate: {command_line(a.folder, a.out)})", file=sys.stderr)
+                return 1
+            print(f"trial_results --check: {shown_path(pathlib.Path(a.out) / 'RESULTS.md')} is current")
+            return 0
+        written = write(a.folder, a.out)
+    except (TrialError, seed_sets.SeedSetError, OSError) as e:
+        print(f"trial_results: {e}", file=sys.stderr)
+        return 2
+    print(f"trial_results: {len(written)} files in {shown_path(a.out)}: " + ", ".join(written))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
