@@ -7,12 +7,18 @@ An entry's fields:
   title             its name in tables and figures (config/paper_results.csv rows use the arm's key)
   rsus              zones (one RSU per zone: rsu_0, rsu_1, ...) | central (one RSU, central,
                     over the whole road) | none (no RSU: nothing learns)
+  advice            where the RSUs' advice comes from: network (the learned policy: a learning
+                    arm) | rules (the rule of config/rules.yaml: a control arm that learns
+                    nothing) | none (no RSU)
   federation, i2i   the RSUs federate through the server / talk to their neighbours
   priority_reward   the reward's priority terms (false: lambda = 0)
   advisory_control  the bridge carries out advice (false: SUMO's own models for every vehicle)
   assist_mode       the bridge's assist_mode (advice on top of the CAVs' own lane changing)
   shipped_policy    policies/<arm>/ is this arm's shipped policy, bridge.yaml included (the
                     launch loads that bridge.yaml when it evaluates the shipped policy)
+  bridge_params     an arm without a shipped policy: the bridge parameters it runs under, a
+                    path under config/ ("" = none), so that a control arm drives its CAVs with
+                    the same actuation as the learned arms' policies (their bridge.yaml)
 
 JSON because roslaunch's $(eval) reads the same file as a Python literal (it has no YAML
 parser); load() checks both readings agree.
@@ -29,8 +35,9 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 REGISTRY = ROOT / "config" / "arms.json"
 FIELDS = {"what": str, "title": str, "rsus": str, "federation": bool, "i2i": bool,
           "priority_reward": bool, "advisory_control": bool, "assist_mode": bool,
-          "shipped_policy": bool}
+          "shipped_policy": bool, "advice": str, "bridge_params": str}
 RSU_RULES = ("zones", "central", "none")
+ADVICE_SOURCES = ("network", "rules", "none")
 # An arm's name becomes a launch argument, a folder name and part of experiment point names.
 NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 
@@ -60,6 +67,20 @@ def check(arms):
             raise RegistryError(f"arm '{name}': without RSUs there is no reward and no policy")
         if entry["assist_mode"] and not entry["advisory_control"]:
             raise RegistryError(f"arm '{name}': assist_mode needs advisory_control")
+        if entry["advice"] not in ADVICE_SOURCES:
+            raise RegistryError(f"arm '{name}': advice '{entry['advice']}' is not one of {', '.join(ADVICE_SOURCES)}")
+        if (entry["rsus"] == "none") != (entry["advice"] == "none"):
+            raise RegistryError(f"arm '{name}': advice '{entry['advice']}' with rsus '{entry['rsus']}' "
+                                "(RSUs advise by network or rules; without RSUs there is no advice)")
+        if entry["advice"] == "rules" and (entry["federation"] or entry["priority_reward"] or entry["shipped_policy"]):
+            raise RegistryError(f"arm '{name}': a rule learns nothing: no federation, reward or shipped policy")
+        if entry["bridge_params"]:
+            if entry["shipped_policy"]:
+                raise RegistryError(f"arm '{name}': a shipped policy carries its own bridge.yaml; bridge_params must be ''")
+            if not entry["advisory_control"]:
+                raise RegistryError(f"arm '{name}': bridge_params without advisory_control change nothing the arm runs")
+            if not (ROOT / "config" / entry["bridge_params"]).is_file():
+                raise RegistryError(f"arm '{name}': bridge_params '{entry['bridge_params']}' is not a file under config/")
     return arms
 
 
@@ -78,7 +99,9 @@ def load(path=REGISTRY):
 
 ARMS = load()
 ALL_ARMS = tuple(ARMS)
-LEARNING_ARMS = tuple(a for a in ARMS if ARMS[a]["rsus"] != "none")
+LEARNING_ARMS = tuple(a for a in ARMS if ARMS[a]["advice"] == "network")
+# Arms whose CAVs are driven by something other than a learned policy: the trial's controls.
+CONTROL_ARMS = tuple(a for a in ARMS if ARMS[a]["advice"] != "network")
 
 
 def is_learning(arm):
@@ -105,7 +128,7 @@ def help_text():
     width = max(len(a) for a in ALL_ARMS)
     lines = ["arms (config/arms.json; a learning arm's shipped policy is policies/<arm>/):"]
     for a in ALL_ARMS:
-        kind = "learning" if is_learning(a) else "no RSU  "
+        kind = {"network": "learning", "rules": "rule    "}.get(ARMS[a]["advice"], "no RSU  ")
         lines.append(f"  {a:<{width}}  {kind}  {ARMS[a]['what']}")
     return "\n".join(lines)
 

@@ -27,6 +27,7 @@ constexpr const char* RANDOM_POLICY = "random";
 /// An evaluation runs trained weights: refused before anything waits for the bridge.
 void requireEvalWeights(const RsuNodeOptions& o) {
   if (o.controller.train || o.policy_dir == RANDOM_POLICY) return;
+  if (o.controller.advice_source == AdviceSource::kRules) return;  // the rule needs no weights
   if (o.policy_dir.empty())
     throw std::runtime_error(
         "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR (a training's "
@@ -130,6 +131,13 @@ std::string RsuNode::checkpointDir() const {
 
 void RsuNode::loadInitialModel() {
   const RsuControllerOptions& c = options_.controller;
+  if (c.advice_source == AdviceSource::kRules) {
+    ROS_INFO_NAMED("startup", "%s: advice from the rule (exit %.0f m per lane + %.0f m, through traffic out of "
+                   "lanes 1..%d, merge advice %s); no weights loaded",
+                   c.rsu_id.c_str(), c.rules.exit_distance_per_lane_m, c.rules.exit_margin_m,
+                   c.rules.through_keep_out_lanes, c.rules.advise_merge ? "on" : "off");
+    return;
+  }
   if (!c.train && options_.policy_dir == RANDOM_POLICY)
     ROS_WARN_NAMED("startup", "%s: evaluating an UNTRAINED network (policy_dir:=%s): its advice is random", c.rsu_id.c_str(),
              RANDOM_POLICY);

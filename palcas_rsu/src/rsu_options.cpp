@@ -27,6 +27,17 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   if (!o.zones_m.empty()) applyZones(o, p.fullName("zones_m"));
   c.num_lanes = p.integer("rsu/num_lanes", 0, 0, 100);  // 0 = the bridge's road
   c.train = p.get<bool>("rsu/train", c.train);
+  const std::string advice = p.get<std::string>("rsu/advice", "network");
+  if (advice == "rules")
+    c.advice_source = AdviceSource::kRules;
+  else if (advice != "network")
+    throw std::invalid_argument("parameter '" + p.fullName("rsu/advice") + "' is '" + advice +
+                                "', not one of network, rules");
+  RuleAdvisorOptions& r = c.rules;
+  r.exit_distance_per_lane_m = p.number("rules/exit_distance_per_lane_m", r.exit_distance_per_lane_m, 1e-3, 1e6);
+  r.exit_margin_m = p.number("rules/exit_margin_m", r.exit_margin_m, 0.0, 1e6);
+  r.through_keep_out_lanes = p.integer("rules/through_keep_out_lanes", r.through_keep_out_lanes, 0, 100);
+  r.advise_merge = p.get<bool>("rules/advise_merge", r.advise_merge);
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);

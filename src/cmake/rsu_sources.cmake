@@ -5,6 +5,7 @@ list(APPEND PALCAS_CORE_SOURCES
   lib/rsu/cluster_stats.cpp
   lib/rsu/rsu_controller.cpp
   lib/rsu/rsu_controller_io.cpp
+  lib/rsu/rule_advisor.cpp
   lib/rsu/transition_book.cpp
   lib/rsu/learning_log.cpp
 )

@@ -19,6 +19,7 @@ sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import palcas_arms  # noqa: E402
 import policy_folder  # noqa: E402
+import seed_sets  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
 PYTHON = "/usr/bin/python3"  # the system Python: ROS's modules and PyYAML
@@ -34,9 +35,31 @@ def entry(**kw):
 class Registry(unittest.TestCase):
     def test_the_arms_and_which_learn(self):
         self.assertEqual(palcas_arms.ALL_ARMS, ("palcas", "palcas_assist", "centralized", "independent",
-                                                "no_priority", "keep", "sumo_native"))
+                                                "no_priority", "rules", "rules_assist", "keep", "sumo_native"))
         self.assertEqual(palcas_arms.LEARNING_ARMS, palcas_arms.ALL_ARMS[:5])
+        self.assertEqual(palcas_arms.CONTROL_ARMS, palcas_arms.ALL_ARMS[5:])
         self.assertFalse(palcas_arms.is_learning("keep"))
+        self.assertFalse(palcas_arms.is_learning("rules"))  # RSUs, but a rule: nothing learns
+
+    def test_control_arms_drive_the_same_cavs_as_the_learned_ones(self):
+        """A fair trial: every arm that carries out advice and has no policy of its own runs under
+        the same bridge parameters the shipped policies carry (their bridge.yaml)."""
+        shipped = {policy_folder.bridge_params(policy_folder.shipped(a)).read_text().split("\n# ")[0]
+                   for a in palcas_arms.LEARNING_ARMS if palcas_arms.ARMS[a]["shipped_policy"]}
+        import yaml
+        shipped_values = {yaml.safe_load(policy_folder.bridge_params(policy_folder.shipped(a)).read_text()).__repr__()
+                          for a in palcas_arms.LEARNING_ARMS if palcas_arms.ARMS[a]["shipped_policy"]}
+        self.assertEqual(len(shipped_values), 1, shipped_values)
+        for arm in palcas_arms.CONTROL_ARMS:
+            e = palcas_arms.ARMS[arm]
+            with self.subTest(arm=arm):
+                if not e["advisory_control"]:
+                    self.assertEqual(e["bridge_params"], "")
+                    continue
+                own = yaml.safe_load((ROOT / "config" / e["bridge_params"]).read_text())
+                self.assertEqual(repr(own), shipped_values.pop() if len(shipped_values) == 1 else None)
+                shipped_values = {repr(own)}
+        self.assertTrue(shipped)
 
     def test_rsu_ids_follow_the_arms_rule(self):
         self.assertEqual(palcas_arms.rsu_ids("centralized", 3), ["central"])
@@ -64,6 +87,16 @@ class Registry(unittest.TestCase):
             self.assertIn(text, str(e.exception))
         with self.assertRaises(palcas_arms.RegistryError):
             palcas_arms.check({"x": entry(assist_mode=True, advisory_control=False)})
+        rules = entry(advice="rules", federation=False, i2i=False, priority_reward=False, shipped_policy=False)
+        palcas_arms.check({"x": rules})  # a rule arm as it should be
+        for arms, text in (({"x": entry(advice="magic")}, "advice 'magic'"),
+                           ({"x": entry(advice="none")}, "without RSUs there is no advice"),
+                           ({"x": dict(rules, federation=True)}, "a rule learns nothing"),
+                           ({"x": dict(rules, bridge_params="no/such.yaml")}, "is not a file under config/"),
+                           ({"x": entry(bridge_params="training/gentle_lane_changes.yaml")}, "carries its own")):
+            with self.subTest(text=text), self.assertRaises(palcas_arms.RegistryError) as e:
+                palcas_arms.check(arms)
+            self.assertIn(text, str(e.exception))
 
     def test_json_that_roslaunch_would_read_otherwise_is_refused(self):
         with tempfile.TemporaryDirectory() as d:
@@ -88,7 +121,7 @@ class Registry(unittest.TestCase):
                     self.assertFalse(folder.exists(), f"{folder} exists: set shipped_policy in config/arms.json")
 
 
-def scratch_copy_with_new_arm():
+def scratch_copy_with_new_arm(new_arm=NEW_ARM, like="independent", after="palcas", **fields):
     """The suite's scripts, tools, configuration and launch files in a temporary folder, the
     policies linked, and one entry added to the copy's config/arms.json (after palcas: its
     order is the registry's)."""
@@ -98,13 +131,13 @@ def scratch_copy_with_new_arm():
         shutil.copytree(ROOT / d, copy / d, ignore=shutil.ignore_patterns("__pycache__"))
     (copy / "policies").symlink_to(ROOT / "policies")
     arms = json.loads((copy / "config" / "arms.json").read_text())
-    new = dict(arms["independent"], what="a test arm", title="Test arm", federation=True, i2i=True,
-               shipped_policy=False)
+    new = dict(arms[like], what="a test arm", title="Test arm", **(fields or dict(
+        federation=True, i2i=True, shipped_policy=False)))
     with_new = {}
     for name, e in arms.items():
         with_new[name] = e
-        if name == "palcas":
-            with_new[NEW_ARM] = new
+        if name == after:
+            with_new[new_arm] = new
     (copy / "config" / "arms.json").write_text(json.dumps(with_new, indent=2) + "\n")
     return copy
 
@@ -160,7 +193,8 @@ class AddingAnArm(unittest.TestCase):
                  "--prs", "60", "--seeds", "1", "--duration", "10", "--scenario", "tiny",
                  "--policy", f"{NEW_ARM}={self.policy}"], cwd=self.copy)
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertIn(f"{NEW_ARM}_pr60_s101", (out / "plan.txt").read_text())
+        first_test_seed = seed_sets.seeds("test", 1)[0]  # experiments report on the test seeds
+        self.assertIn(f"{NEW_ARM}_pr60_s{first_test_seed}", (out / "plan.txt").read_text())
 
     def test_figures_order_and_tables_title_it(self):
         r = run([PYTHON, "-c", "import sys; sys.path.insert(0, 'tools'); import run_figures, experiment_results; "
@@ -199,6 +233,63 @@ class AddingAnArm(unittest.TestCase):
                  "out_dir:=/tmp/unused"], cwd=ROOT)
         self.assertNotEqual(r.returncode, 0)
         self.assertIn(f"unknown_arm_{NEW_ARM}", r.stdout + r.stderr)
+
+
+
+
+CONTROL_ARM = "test_rule_arm"
+
+
+class AddingAControlArm(unittest.TestCase):
+    """A non-learning control arm (RSUs advising by the rule) is one registry entry too, and
+    every command runs it like any other arm."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.copy = scratch_copy_with_new_arm(CONTROL_ARM, like="rules", after="rules", i2i=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.copy, ignore_errors=True)
+
+    def test_it_is_a_control_not_a_learning_arm(self):
+        r = run([PYTHON, "tools/palcas_arms.py", "--help-text"], cwd=self.copy)
+        self.assertIn(f"  {CONTROL_ARM}", r.stdout)
+        line = next(l for l in r.stdout.splitlines() if l.strip().startswith(CONTROL_ARM))
+        self.assertIn("rule", line.split()[1])
+        r = run([PYTHON, "tools/palcas_arms.py", "--list", "learning"], cwd=self.copy)
+        self.assertNotIn(CONTROL_ARM, r.stdout.split())
+
+    def test_run_and_experiment_take_it_without_a_policy(self):
+        r = run([PYTHON, "tools/palcas_cli", "check", "run", "--arm", CONTROL_ARM, "--duration", "10"], cwd=self.copy)
+        self.assertEqual(r.returncode, 0, r.stderr)  # good options: only the workspace is missing
+        r = run([PYTHON, "tools/palcas_cli", "check", "train", "--arm", CONTROL_ARM], cwd=self.copy)
+        self.assertEqual(r.returncode, 2, r.stderr)  # a rule learns nothing
+        out = self.copy / "experiment"
+        r = run([PYTHON, "tools/palcas_cli", "experiment", "--plan", "--out", str(out), "--arms", f"keep,{CONTROL_ARM}",
+                 "--prs", "60", "--seeds", "1", "--duration", "10", "--scenario", "tiny"], cwd=self.copy)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(f"{CONTROL_ARM}_pr60_s{seed_sets.seeds('test', 1)[0]}", (out / "plan.txt").read_text())
+
+    def test_the_launch_starts_rule_rsus_under_the_learned_arms_actuation(self):
+        if not shutil.which("roslaunch") or "ROS_PACKAGE_PATH" not in os.environ:
+            self.fail("needs the workspace's ROS environment: source devel/setup.bash first")
+        env = dict(os.environ, ROS_PACKAGE_PATH=f"{self.copy}:{os.environ['ROS_PACKAGE_PATH']}",
+                   PATH="/usr/bin:" + os.environ["PATH"])
+        launch = str(self.copy / "launch" / "system.launch")
+        r = run(["roslaunch", "--nodes", launch, f"arm:={CONTROL_ARM}", "out_dir:=/tmp/unused"], cwd=self.copy, env=env)
+        self.assertEqual(sorted(r.stdout.split()), ["/palcas_sumo_bridge", "/rsu_0/rsu", "/rsu_1/rsu", "/rsu_2/rsu"],
+                         r.stdout + r.stderr)  # no federation server: a rule learns nothing
+        r = run(["roslaunch", "--dump-params", launch, f"arm:={CONTROL_ARM}", "out_dir:=/tmp/unused"],
+                cwd=self.copy, env=env)
+        lines = r.stdout.splitlines()
+        for line in ("/rsu_0/rsu/rsu/advice: rules", "/rsu_0/rsu/rsu/train: false", "/rsu_0/rsu/i2i: true",
+                     "/rsu_0/rsu/federation: false", "/rsu_0/rsu/rules/exit_distance_per_lane_m: 300.0",
+                     "/palcas_sumo_bridge/advisory_control: true",
+                     # the shipped policies' own bridge.yaml value: the same actuation
+                     "/palcas_sumo_bridge/lane_change_max_accel_mps2: 1.47"):
+            self.assertIn(line, lines, r.stderr)
+        self.assertIn("/rsu_0/rsu/policy_dir: ''", lines)  # no weights asked for
 
 
 if __name__ == "__main__":

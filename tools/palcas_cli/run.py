@@ -60,7 +60,8 @@ def check(argv):
     p.update(choose_policy(p, arm))
     p["scenario"] = p.get("scenario") or "paper"
     # The columns, all on the same traffic: the learning arm, then keep and sumo_native.
-    arms = [p.arm] if p.policy else []
+    # A control arm (no learned policy) is its own column, like a policy's.
+    arms = [p.arm] if p.policy or (arm and arm not in ("keep", "sumo_native")) else []
     arms += [a for a in ("keep", "sumo_native") if p.compare or p.arm == a]
     if not arms:
         raise OptionError("--no-compare: nothing to run, policies/palcas/ is missing (pass --arm or --policy DIR)")
@@ -180,7 +181,8 @@ def run_arms(p, console, show, rviz):
                      "policy_bridge_params:=" + own_bridge]
         else:
             console.log("%s -> %s" % (arm, folder))
-            args += ["out_dir:=" + folder] + (["paper_printed:=" + p.paper_printed] if arm == "keep" else [])
+            advised = palcas_arms.ARMS.get(arm, {}).get("advisory_control", False)
+            args += ["out_dir:=" + folder] + (["paper_printed:=" + p.paper_printed] if advised else [])
         launch_arm(args, folder, p.rviz, rviz, console, show)
         if palcas_arms.is_learning(arm) and os.path.isfile(metrics):
             add_training_facts.main(metrics, p.policy)

@@ -44,6 +44,9 @@ void RsuControllerOptions::validate() const {
   require(num_lanes >= 1, "num_lanes", num_lanes, "must be >= 1");
   require(std::isfinite(gradient_steps_per_decision) && gradient_steps_per_decision >= 0.0,
           "gradient_steps_per_decision", gradient_steps_per_decision, "must be finite and >= 0");
+  require(advice_source == AdviceSource::kNetwork || !train, "train", "true",
+          "is not possible with advice_source rules (a rule learns nothing)");
+  nested("rules", [&] { rules.validate(); });
   nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
   nested("scales", [&] { validateScales(scales); });
@@ -58,6 +61,7 @@ struct RsuController::Observation {
   ClusterSummary cluster;
   std::vector<std::string> member_ids;
   std::vector<int> member_lanes;       // paper lane of each member (0 = acceleration lane)
+  std::vector<const VehicleSnapshot*> member_vehicles;  // into the snapshot being advised
   nn::Matrix member_states;            // state_size x members
   std::vector<double> member_rewards;  // train mode only
   std::vector<double> member_exit_m;   // distance to exit of each member (train mode)
@@ -157,10 +161,11 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
     if (isMember(v) && events.removed.count(v.id) == 0) {
       obs.member_ids.push_back(v.id);
       obs.member_lanes.push_back(v.lane);
+      obs.member_vehicles.push_back(&v);
       obs.member_exit_m.push_back(v.distance_to_exit_m);
     }
   }
-  if (!obs.member_ids.empty())
+  if (!obs.member_ids.empty() && options_.advice_source == AdviceSource::kNetwork)
     obs.member_states = builder_.buildStates(finder, obs.member_ids, stats, global);
   if (!options_.train) return obs;
   obs.member_rewards = rewardsOf(finder, obs.member_ids, stats, options_.reward);
@@ -225,7 +230,13 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
-  if (!obs.member_ids.empty()) agent_.act(obs.member_states, options_.train, decisions);
+  if (options_.advice_source == AdviceSource::kRules) {
+    decisions.reserve(obs.member_vehicles.size());
+    for (const VehicleSnapshot* v : obs.member_vehicles)
+      decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
+  } else if (!obs.member_ids.empty()) {
+    agent_.act(obs.member_states, options_.train, decisions);
+  }
   for (size_t i = 0; i < decisions.size(); ++i)
     decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);
 

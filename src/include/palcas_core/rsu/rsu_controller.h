@@ -22,10 +22,17 @@
 #include "palcas_core/reward/reward.h"
 #include "palcas_core/reward/terminal_rewards.h"
 #include "palcas_core/rsu/cluster_stats.h"
+#include "palcas_core/rsu/rule_advisor.h"
 #include "palcas_core/rsu/transition_book.h"
 #include "palcas_core/state/state_builder.h"
 
 namespace palcas::rsu {
+
+/// Where an RSU's advice comes from.
+enum class AdviceSource {
+  kNetwork,  ///< the PDQN policy (the learning arms)
+  kRules,    ///< the documented rule of rule_advisor.h (the `rules` control arm; never learns)
+};
 
 /// Every knob of one RSU controller (config/rsu.yaml, config/reward.yaml, config/learning.yaml).
 struct RsuControllerOptions {
@@ -35,6 +42,10 @@ struct RsuControllerOptions {
   double x_end_m = 800.0;
   int num_lanes = 5;  ///< mainline lanes L >= 1; pdqn.state_size must be 40 + L
   bool train = true;  ///< true: explore, remember, update; false: greedy evaluation only
+  /// kRules: the advice comes from ruleDecision() with `rules` (train must be false; the
+  /// network is built but never asked).
+  AdviceSource advice_source = AdviceSource::kNetwork;
+  RuleAdvisorOptions rules;  ///< the rule's thresholds (used with kRules)
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;

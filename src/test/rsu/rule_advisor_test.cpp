@@ -1,0 +1,162 @@
+// The rule advisor (rule_advisor.h) alone, and behind RsuController's decision interface.
+#include "palcas_core/rsu/rule_advisor.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <stdexcept>
+
+#include "common/throws_naming.h"
+#include "palcas_core/rsu/rsu_controller.h"
+
+using palcas::Action;
+using palcas::GlobalDensities;
+using palcas::RoadSnapshot;
+using palcas::VehicleSnapshot;
+using palcas::rsu::AdviceSource;
+using palcas::rsu::RsuController;
+using palcas::rsu::RsuControllerOptions;
+using palcas::rsu::ruleDecision;
+using palcas::rsu::RuleAdvisorOptions;
+using palcas::rsu::VehicleOutcomes;
+
+namespace {
+
+constexpr double NO_EXIT = std::numeric_limits<double>::infinity();
+constexpr int LANES = 5;
+
+VehicleSnapshot cav(const std::string& id, int lane, double x, double to_exit_m = NO_EXIT) {
+  VehicleSnapshot v;
+  v.id = id;
+  v.is_cav = true;
+  v.lane = lane;
+  v.x_m = x;
+  v.lateral_m = lane >= 1 ? 3.2 * (lane - 0.5) : -1.6;
+  v.speed_mps = 25.0;
+  v.distance_to_exit_m = to_exit_m;
+  return v;
+}
+
+VehicleSnapshot onAccelLane(const std::string& id, double x) {
+  VehicleSnapshot v = cav(id, 0, x);
+  v.on_accel_lane = true;
+  v.accel_lane_length_m = 200.0;
+  v.accel_lane_pos_m = 50.0;
+  return v;
+}
+
+Action advice(const VehicleSnapshot& v, const RuleAdvisorOptions& o = {}) {
+  return ruleDecision(v, LANES, o).action;
+}
+
+}  // namespace
+
+TEST(RuleAdvisor, ExitBoundCavMovesRightOnlyOnceItsDistanceIsShortForTheLanesLeft) {
+  RuleAdvisorOptions o;
+  o.exit_distance_per_lane_m = 300.0;
+  o.exit_margin_m = 100.0;
+  // Lane 3: two lanes to cross, needs 100 + 2 x 300 = 700 m.
+  EXPECT_EQ(advice(cav("a", 3, 0.0, 701.0), o), Action::kKeep);
+  EXPECT_EQ(advice(cav("a", 3, 0.0, 699.0), o), Action::kLaneRight);
+  // Lane 5: four lanes, 1300 m.
+  EXPECT_EQ(advice(cav("b", 5, 0.0, 1299.0), o), Action::kLaneRight);
+  EXPECT_EQ(advice(cav("b", 5, 0.0, 1301.0), o), Action::kKeep);
+  // Already in lane 1: nothing to cross, never pushed further right or left.
+  EXPECT_EQ(advice(cav("c", 1, 0.0, 10.0), o), Action::kKeep);
+  EXPECT_EQ(advice(cav("c", 1, 0.0, 5000.0), o), Action::kKeep);
+}
+
+TEST(RuleAdvisor, ThroughCavsLeaveTheKeepOutLanesAndStayElsewhere) {
+  RuleAdvisorOptions o;
+  o.through_keep_out_lanes = 1;
+  EXPECT_EQ(advice(cav("t", 1, 0.0), o), Action::kLaneLeft);
+  EXPECT_EQ(advice(cav("t", 2, 0.0), o), Action::kKeep);
+  o.through_keep_out_lanes = 2;
+  EXPECT_EQ(advice(cav("t", 2, 0.0), o), Action::kLaneLeft);
+  EXPECT_EQ(advice(cav("t", 3, 0.0), o), Action::kKeep);
+  o.through_keep_out_lanes = 0;  // off
+  EXPECT_EQ(advice(cav("t", 1, 0.0), o), Action::kKeep);
+  // Never left of the leftmost lane, however many lanes are kept clear.
+  o.through_keep_out_lanes = LANES;
+  EXPECT_EQ(advice(cav("t", LANES, 0.0), o), Action::kKeep);
+}
+
+TEST(RuleAdvisor, OnRampCavIsAdvisedOntoTheMainlineUnlessSwitchedOff) {
+  RuleAdvisorOptions o;
+  EXPECT_EQ(advice(onAccelLane("m", 100.0), o), Action::kLaneLeft);
+  o.advise_merge = false;
+  EXPECT_EQ(advice(onAccelLane("m", 100.0), o), Action::kKeep);
+  // On a ramp off the mainline (lane 0, not an acceleration lane): nothing.
+  EXPECT_EQ(advice(cav("r", 0, 100.0, 20.0), o), Action::kKeep);
+}
+
+TEST(RuleAdvisor, NeverAdvisesAnAcceleration) {
+  for (int lane = 1; lane <= LANES; ++lane)
+    for (double to_exit : {NO_EXIT, 50.0, 400.0, 3000.0}) {
+      const auto d = ruleDecision(cav("x", lane, 0.0, to_exit), LANES, {});
+      EXPECT_NE(d.action, Action::kAccelerate);
+      EXPECT_EQ(d.accel_mps2, 0.0f);
+    }
+}
+
+TEST(RuleAdvisor, BadThresholdsAreRefusedByName) {
+  RuleAdvisorOptions o;
+  o.exit_distance_per_lane_m = 0.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { o.validate(); }, "exit_distance_per_lane_m");
+  o = {};
+  o.exit_margin_m = std::numeric_limits<double>::quiet_NaN();
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { o.validate(); }, "exit_margin_m");
+  o = {};
+  o.through_keep_out_lanes = -1;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { o.validate(); }, "through_keep_out_lanes");
+}
+
+namespace {
+
+RsuControllerOptions ruleController() {
+  RsuControllerOptions o;
+  o.rsu_id = "rsu_0";
+  o.x_start_m = 0.0;
+  o.x_end_m = 800.0;
+  o.train = false;
+  o.advice_source = AdviceSource::kRules;
+  o.pdqn.hidden_sizes = {8};
+  return o;
+}
+
+}  // namespace
+
+TEST(RuleAdvisor, RsuControllerWithRulesAdvisesEveryMemberByTheRule) {
+  RsuController rsu(ruleController());
+  RoadSnapshot road;
+  road.num_lanes = LANES;
+  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0),
+                   cav("through_lane1", 1, 400.0), onAccelLane("merging", 200.0),
+                   cav("outside_zone", 1, 900.0)};
+  VehicleSnapshot hdv = cav("hdv", 1, 150.0);
+  hdv.is_cav = false;
+  road.vehicles.push_back(hdv);
+  const auto out = rsu.advise(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{});
+  ASSERT_EQ(out.advisories.size(), 4u);  // the CAVs of [0, 800) only
+  EXPECT_EQ(out.advisories[0].vehicle_id, "exit_far");
+  EXPECT_EQ(out.advisories[0].decision.action, Action::kKeep);
+  EXPECT_EQ(out.advisories[1].decision.action, Action::kLaneRight);
+  EXPECT_EQ(out.advisories[2].decision.action, Action::kLaneLeft);
+  EXPECT_EQ(out.advisories[3].vehicle_id, "merging");
+  EXPECT_EQ(out.advisories[3].decision.action, Action::kLaneLeft);
+  EXPECT_EQ(rsu.stats().action_counts[static_cast<size_t>(Action::kLaneRight)], 1u);
+  // The same road gives the same advice: the rule holds no state.
+  const auto again = rsu.advise(road, 20, 2.0, GlobalDensities{}, VehicleOutcomes{});
+  for (size_t i = 0; i < out.advisories.size(); ++i)
+    EXPECT_EQ(again.advisories[i].decision.action, out.advisories[i].decision.action);
+}
+
+TEST(RuleAdvisor, RsuControllerRefusesToTrainARuleAndBadRuleOptions) {
+  RsuControllerOptions o = ruleController();
+  o.train = true;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController rsu(o); }, "advice_source rules");
+  o = ruleController();
+  o.rules.exit_distance_per_lane_m = -5.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController rsu(o); },
+                                                        "rules: RuleAdvisorOptions: exit_distance_per_lane_m");
+}
