@@ -27,6 +27,7 @@ MeasureRules measureRules(const BridgeOptions& o, const sim::RoadLayout& road) {
   rules.tracker.stop_speed_mps = o.merge_stop_speed_mps;
   rules.tracker.stop_window_m = o.merge_stop_window_m;
   rules.metrics.comfort_accel_mps2 = o.comfort_threshold_mps2;
+  rules.metrics.steady_state_from_s = o.steady_state_from_s;
   return rules;
 }
 
@@ -312,6 +313,8 @@ void BridgeNode::writeEpisode(int episode, const sim::EpisodeRun& run) {
   summary.route_changes_failed = session().routeChangesFailed();
   summary.guard = session().guardCounters();
   summary.insertion_dropped = session().insertionDropped();
+  summary.insertion_waiting_end = session().insertionWaiting();
+  summary.insertion_wait_veh_s = session().insertionWaitVehicleSeconds();
   summary.downlink = run.downlink;
   writeMetricsJson(options_, summary, episode);
   ROS_INFO_NAMED("episode", "palcas bridge: episode %d/%d done: %.0f s simulated in %.1f s; results in %s", episode + 1,

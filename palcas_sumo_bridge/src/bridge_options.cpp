@@ -164,6 +164,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.merge_stop_speed_mps = p.number("merge_stop_speed_mps", o.merge_stop_speed_mps, 0.0, 10.0);
   o.merge_stop_window_m = p.number("merge_stop_window_m", o.merge_stop_window_m, 0.0, 1000.0);
   o.comfort_threshold_mps2 = p.number("comfort_threshold_mps2", o.comfort_threshold_mps2, 0.0, 20.0);
+  o.steady_state_from_s = p.number("steady_state_from_s", o.steady_state_from_s, 0.0, 1e7);
   p.rejectUnknownKeys("palcas_sumo_bridge/README.md");
   return o;
 }

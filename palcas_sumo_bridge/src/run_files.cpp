@@ -187,7 +187,8 @@ void completeManifest(const BridgeOptions& o, const std::string& sumo_version,
                                {"miss_margin_m", rules.tracker.miss_margin_m},
                                {"stop_speed_mps", rules.tracker.stop_speed_mps},
                                {"stop_window_m", rules.tracker.stop_window_m},
-                               {"comfort_accel_mps2", rules.metrics.comfort_accel_mps2}};
+                               {"comfort_accel_mps2", rules.metrics.comfort_accel_mps2},
+                               {"steady_state_from_s", rules.metrics.steady_state_from_s}};
   writeAtomically(path, manifest);
 }
 
@@ -210,6 +211,8 @@ MeasureRules readMeasureRules(const std::string& manifest_path) {
     rules.tracker.stop_speed_mps = r.at("stop_speed_mps").get<double>();
     rules.tracker.stop_window_m = r.at("stop_window_m").get<double>();
     rules.metrics.comfort_accel_mps2 = r.at("comfort_accel_mps2").get<double>();
+    // Manifests from before the steady-state window: its default.
+    rules.metrics.steady_state_from_s = r.value("steady_state_from_s", rules.metrics.steady_state_from_s);
   } catch (const json::exception& e) {
     throw std::runtime_error("'" + manifest_path + "': measure_rules incomplete: " + e.what());
   }
@@ -325,6 +328,16 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"comfort_share_pct", number(m.comfort_share_pct)},
               {"throughput_vph", number(m.throughput_vph)},
               {"insertion_dropped", s.insertion_dropped},
+              {"insertion_waiting_end", s.insertion_waiting_end},
+              {"unserved_vehicles", s.insertion_dropped + s.insertion_waiting_end},
+              {"insertion_wait_veh_h", s.insertion_wait_veh_s / 3600.0},
+              // Total time spent: on the road plus waiting to enter (the demand's own cost).
+              {"total_time_spent_veh_h", (m.vehicle_seconds_on_road + s.insertion_wait_veh_s) / 3600.0},
+              {"efficiency_steady_mps", number(m.efficiency_steady_mps)},
+              {"exiting_cavs_censored", m.exiting_cavs_censored},
+              {"dsr_censored_pct", number(m.dsr_censored_pct)},
+              {"merging_cavs_censored", m.merging_cavs_censored},
+              {"msr_censored_pct", number(m.msr_censored_pct)},
               {"mean_travel_time_s", number(m.mean_travel_time_s)},
               {"lane_changes_per_cav", number(m.lane_changes_per_cav)},
               {"arrived", m.arrived},

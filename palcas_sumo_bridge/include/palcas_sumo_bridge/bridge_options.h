@@ -66,6 +66,8 @@ struct BridgeOptions {
   double merge_stop_speed_mps = 0.1;  ///< "stopped" below this speed [m/s] ...
   double merge_stop_window_m = 10.0;  ///< ... within this distance of the acceleration lane's end [m]
   double comfort_threshold_mps2 = 1.47;
+  /// efficiency_steady_mps counts samples from this simulation time on [s] (the road has filled).
+  double steady_state_from_s = 600.0;
 };
 
 /// Reads the private parameters of the node, ~scenario/* included. @throws

@@ -36,6 +36,8 @@ struct RunSummary {
   std::uint64_t route_changes_failed = 0;  ///< exit route changes SUMO refused
   sim::GuardCounters guard;  ///< how often the advice guard acted
   std::uint64_t insertion_dropped = 0;  ///< vehicles SUMO dropped at insertion (max_depart_delay_s)
+  std::uint64_t insertion_waiting_end = 0;  ///< vehicles still waiting to enter at the end
+  double insertion_wait_veh_s = 0.0;  ///< vehicle-seconds spent waiting to enter (dropped ones too)
   v2x::DownlinkCounts downlink;  ///< the advisories' way through the V2X channel
 };
 

@@ -187,7 +187,11 @@ const StepEvents& SumoSession::step() {
   vanished_vehicles_ += vanished.size();
   api::Simulation::step();
   ++step_count_;
+  const double before_s = time_s_;
   time_s_ = api::Simulation::getTime();
+  // The queue after a step waited the whole step (a vehicle due within it: at most a step).
+  insertion_waiting_ = api::Simulation::getPendingVehicles().size();
+  insertion_wait_veh_s_ += static_cast<double>(insertion_waiting_) * (time_s_ - before_s);
 
   events_ = StepEvents{};
   const libsumo::TraCIResults sim = api::Simulation::getSubscriptionResults();

@@ -28,6 +28,9 @@ EpisodeMetricsAccumulator::EpisodeMetricsAccumulator(const EpisodeMetricsOptions
   if (!std::isfinite(options_.comfort_accel_mps2) || options_.comfort_accel_mps2 < 0.0)
     throw std::invalid_argument("EpisodeMetricsOptions: comfort_accel_mps2 is " +
                                 common::text(options_.comfort_accel_mps2) + ", must be finite and >= 0");
+  if (!std::isfinite(options_.steady_state_from_s) || options_.steady_state_from_s < 0.0)
+    throw std::invalid_argument("EpisodeMetricsOptions: steady_state_from_s is " +
+                                common::text(options_.steady_state_from_s) + ", must be finite and >= 0");
 }
 
 void EpisodeMetricsAccumulator::checkSample(const SpeedSample& sample) {
@@ -43,6 +46,11 @@ void EpisodeMetricsAccumulator::apply(const SpeedSample& sample) {
   // Efficiency (paper "Traffic Efficiency"): mean of v over every (vehicle, step) sample.
   speed_sum_all_ += sample.speed_mps;
   ++samples_all_;
+  // Samples come before their step's setSimSeconds: sim_seconds_ is the previous step's time.
+  if (sim_seconds_ >= options_.steady_state_from_s) {
+    speed_sum_steady_ += sample.speed_mps;
+    ++samples_steady_;
+  }
   if (!sample.is_cav) return;
   speed_sum_cav_ += sample.speed_mps;
   ++samples_cav_;
@@ -201,6 +209,8 @@ void EpisodeMetricsAccumulator::setSimSeconds(double sim_seconds) {
   if (!std::isfinite(sim_seconds) || sim_seconds < sim_seconds_)
     throw std::invalid_argument("EpisodeMetricsAccumulator: sim_seconds " + common::text(sim_seconds) +
                                 " must be finite and >= the previous " + common::text(sim_seconds_));
+  // Every vehicle on the road spent the interval on it (those departing now join after).
+  vehicle_seconds_ += static_cast<double>(on_road_.size()) * (sim_seconds - sim_seconds_);
   sim_seconds_ = sim_seconds;
 }
 
@@ -219,6 +229,15 @@ EpisodeMetrics EpisodeMetricsAccumulator::snapshot() const {
                                ? NOT_A_NUMBER
                                : static_cast<double>(counts_.cav_lane_changes) / counts_.cavs_seen;
   m.vehicles_on_road = static_cast<std::uint32_t>(on_road_.size());
+  m.efficiency_steady_mps = mean(speed_sum_steady_, samples_steady_);
+  m.vehicle_seconds_on_road = vehicle_seconds_;
+  for (const auto& [id, v] : on_road_) {
+    if (!v.is_cav) continue;
+    if (routeHasExit(v.route_kind) && v.exit == Outcome::kUndecided) ++m.exiting_cavs_censored;
+    if (routeFromRamp(v.route_kind) && v.merge == Outcome::kUndecided) ++m.merging_cavs_censored;
+  }
+  m.dsr_censored_pct = percent(counts_.exits_ok, std::uint64_t{counts_.exiting_cavs} + m.exiting_cavs_censored);
+  m.msr_censored_pct = percent(counts_.merges_ok, std::uint64_t{counts_.merging_cavs} + m.merging_cavs_censored);
   m.advisories_rejected = std::accumulate(rejections_.begin(), rejections_.end(), std::uint64_t{0});
   return m;
 }

@@ -349,3 +349,53 @@ TEST(EpisodeMetrics, LaneChangesPerCavCountMainlineLaneChangesOfCavs) {
   EXPECT_THROW(acc.addLaneSamples({{"c1", 2}, {"c3", -1}}), std::invalid_argument);
   EXPECT_EQ(acc.snapshot().cav_lane_changes, 5u);    // c1's good sample was not added
 }
+
+TEST(EpisodeMetrics, SteadyStateSpeedCountsOnlySamplesFromItsStartOn) {
+  EpisodeMetricsOptions o;
+  o.steady_state_from_s = 10.0;
+  EpisodeMetricsAccumulator acc(o);
+  acc.addSample(false, 30.0, 0.0);  // t = 0: before the window
+  acc.setSimSeconds(5.0);
+  acc.addSample(false, 28.0, 0.0);  // sampled after t = 5: still before
+  acc.setSimSeconds(10.0);
+  acc.addSamples({{false, 12.0, 0.0}, {true, 18.0, 0.0}});  // after t = 10: in
+  acc.setSimSeconds(10.1);
+  const auto m = acc.snapshot();
+  EXPECT_DOUBLE_EQ(m.efficiency_steady_mps, 15.0);  // (12 + 18) / 2
+  EXPECT_DOUBLE_EQ(m.efficiency_all_mps, 22.0);     // (30 + 28 + 12 + 18) / 4
+  EXPECT_TRUE(std::isnan(EpisodeMetricsAccumulator(o).snapshot().efficiency_steady_mps));
+  o.steady_state_from_s = -1.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { EpisodeMetricsAccumulator bad(o); },
+                                                        "steady_state_from_s");
+}
+
+TEST(EpisodeMetrics, VehicleSecondsCountEachVehicleFromDepartureToRemovalOrTheEnd) {
+  EpisodeMetricsAccumulator acc;
+  acc.setSimSeconds(1.0);
+  depart(acc, {"a", "b"}, false, RouteKind::kMainThrough);  // on the road from t = 1
+  acc.setSimSeconds(4.0);                                   // 2 x 3 s
+  acc.addEvent(ev("a", false, VehicleEventKind::kArrived));  // a leaves at t = 4
+  depart(acc, {"c"}, true, RouteKind::kMainThrough);        // c from t = 4
+  acc.setSimSeconds(6.0);                                   // b and c: 2 x 2 s
+  EXPECT_DOUBLE_EQ(acc.snapshot().vehicle_seconds_on_road, 10.0);  // 6 + 4
+}
+
+TEST(EpisodeMetrics, CensoredCavsCountAgainstTheCensoredRatesOnly) {
+  EpisodeMetricsAccumulator acc;
+  // Three exit-bound CAVs: one exits, one misses, one is still on the road at the end.
+  depart(acc, {"x1", "x2", "x3"}, true, RouteKind::kMainExit);
+  acc.addEvent(ev("x1", true, VehicleEventKind::kExitOk, RouteKind::kMainExit));
+  acc.addEvent(ev("x2", true, VehicleEventKind::kExitMissed, RouteKind::kMainExit));
+  // Two merging CAVs: one merged, one still on its ramp; a merging HDV is not counted.
+  depart(acc, {"m1", "m2"}, true, RouteKind::kRampThrough);
+  depart(acc, {"h"}, false, RouteKind::kRampThrough);
+  acc.addEvent(ev("m1", true, VehicleEventKind::kMergeOk, RouteKind::kRampThrough));
+  const auto m = acc.snapshot();
+  EXPECT_EQ(m.exiting_cavs, 2u);
+  EXPECT_EQ(m.exiting_cavs_censored, 1u);
+  EXPECT_DOUBLE_EQ(m.dsr_pct, 50.0);                   // 1 of 2 decided
+  EXPECT_DOUBLE_EQ(m.dsr_censored_pct, 100.0 / 3.0);   // 1 of 3
+  EXPECT_EQ(m.merging_cavs_censored, 1u);
+  EXPECT_DOUBLE_EQ(m.msr_pct, 100.0);                  // 1 of 1 decided
+  EXPECT_DOUBLE_EQ(m.msr_censored_pct, 50.0);          // 1 of 2
+}

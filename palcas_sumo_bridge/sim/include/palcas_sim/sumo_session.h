@@ -305,6 +305,11 @@ class SumoSession {
   /// Vehicles SUMO dropped at insertion so far: loaded from a flow, never departed, no
   /// longer waiting (they waited longer than --max-depart-delay). Asks SUMO.
   std::uint64_t insertionDropped() const;
+  /// Vehicles in SUMO's insertion queue after the latest step: due, not yet on the road.
+  std::uint64_t insertionWaiting() const { return insertion_waiting_; }
+  /// Vehicle-seconds spent in the insertion queue so far (the integral of its length over
+  /// time: every wait to enter, of vehicles that entered, were dropped or still wait).
+  double insertionWaitVehicleSeconds() const { return insertion_wait_veh_s_; }
 
   /// "sumo x.y.z" of the running SUMO.
   std::string sumoVersion() const;
@@ -378,6 +383,8 @@ class SumoSession {
   /// No command of ours: its own car following (or, with own_car_following off, its speed).
   void holdOwnDriving(VehicleRecord& v) const;
   std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
+  std::uint64_t insertion_waiting_ = 0;  ///< insertion queue after the latest step
+  double insertion_wait_veh_s_ = 0.0;    ///< its integral over time since the start
 };
 
 /// Route kind and clusters from a route id "r_<from>_<to>" (from: main | on<k>;

@@ -29,6 +29,18 @@ struct EpisodeMetrics {
   double throughput_vph = 0.0;      ///< 3600 * arrived / sim_seconds [veh/h]
   double mean_travel_time_s = 0.0;  ///< mean (arrival - departure time) of arrived vehicles [s]
   double lane_changes_per_cav = 0.0;  ///< cav_lane_changes / cavs_seen
+  /// Mean speed of all vehicle samples once the road has filled (steady_state_from_s on) [m/s].
+  double efficiency_steady_mps = 0.0;
+  /// Vehicle-seconds spent on the road: each vehicle from its DEPARTED to its removal or the
+  /// latest time (the wait to enter is the bridge's, SUMO's insertion queue) [veh s].
+  double vehicle_seconds_on_road = 0.0;
+  /// CAVs bound for an off-ramp / from an on-ramp still on the road with that outcome open:
+  /// censored by the episode's end. dsr_censored_pct / msr_censored_pct count them as not
+  /// (yet) served: 100 * ok / (decided + censored).
+  std::uint32_t exiting_cavs_censored = 0;
+  std::uint32_t merging_cavs_censored = 0;
+  double dsr_censored_pct = 0.0;
+  double msr_censored_pct = 0.0;
   std::uint32_t collisions = 0;     ///< vehicles involved in a collision, all kinds
   std::uint32_t cav_collisions = 0;
   std::uint32_t teleports = 0;      ///< vehicles teleported, all kinds
@@ -61,13 +73,17 @@ struct LaneSample {
 
 struct EpisodeMetricsOptions {
   double comfort_accel_mps2 = 1.47;  ///< a_th of the comfort share [m/s^2] (paper "Comfort")
+  /// Samples from this simulation time on count in efficiency_steady_mps [s] (finite, >= 0):
+  /// the road has filled by then, so the mean is not diluted by the empty start.
+  double steady_state_from_s = 600.0;
 };
 
 /// Accumulates one episode. O(1) per sample and per event (hash map of the vehicles on the
 /// road). Not thread-safe.
 class EpisodeMetricsAccumulator {
  public:
-  /// Throws std::invalid_argument when comfort_accel_mps2 is not finite or negative.
+  /// Throws std::invalid_argument when comfort_accel_mps2 or steady_state_from_s is not
+  /// finite or negative.
   explicit EpisodeMetricsAccumulator(const EpisodeMetricsOptions& options = {});
 
   /// One vehicle, one step. Throws std::invalid_argument naming the field for a NaN /
@@ -129,8 +145,9 @@ class EpisodeMetricsAccumulator {
 
   EpisodeMetricsOptions options_;
   double sim_seconds_ = 0.0;
-  double speed_sum_all_ = 0.0, speed_sum_cav_ = 0.0;
-  std::uint64_t samples_all_ = 0, samples_cav_ = 0, comfortable_cav_ = 0;
+  double speed_sum_all_ = 0.0, speed_sum_cav_ = 0.0, speed_sum_steady_ = 0.0;
+  std::uint64_t samples_all_ = 0, samples_cav_ = 0, comfortable_cav_ = 0, samples_steady_ = 0;
+  double vehicle_seconds_ = 0.0;  ///< on-road vehicle-seconds up to sim_seconds_
   double travel_time_sum_s_ = 0.0;  ///< over arrived vehicles
   EpisodeMetrics counts_;  ///< counters only; rates are computed in snapshot()
   std::array<std::uint64_t, REJECTION_REASON_COUNT> rejections_{};
