@@ -45,9 +45,9 @@ from palcas_arms import ALL_ARMS, LEARNING_ARMS
 
 PAPER_PRS = (5, 10, 20, 40, 60)
 # Settings that define the experiment: a continuation must not change them.
-FIXED_KEYS = ("duration_s", "scenario", "v2x", "bridge_params")
+FIXED_KEYS = ("duration_s", "scenario", "v2x", "bridge_params", "rsu_params")
 # Files every point runs with: settings key, ./palcas run option.
-POINT_FILES = (("v2x", "--v2x"), ("bridge_params", "--bridge-params"))
+POINT_FILES = (("v2x", "--v2x"), ("bridge_params", "--bridge-params"), ("rsu_params", "--rsu-params"))
 
 
 class UsageError(OptionError):
@@ -387,6 +387,8 @@ def common_options(p):
     p.add_argument("--duration", type=float, default=1800.0)
     p.add_argument("--scenario", default="paper")
     p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
+    p.add_argument("--rsu-params", dest="rsu_params", default="", metavar="FILE",
+                   help="an RSU parameter override for every point (./palcas run --rsu-params)")
     p.add_argument("--bridge-params", dest="bridge_params", default="", metavar="FILE",
                    help="a bridge parameter override for every point (./palcas run --bridge-params)")
     p.add_argument("--policy", action="append", metavar="ARM=DIR")

@@ -20,7 +20,7 @@ import policy_folder
 
 VALUES = {"--duration": "duration", "--pr": "pr", "--demand": "demand", "--ramp-demand": "ramp_demand",
           "--seed": "seed", "--real-time-factor": "real_time_factor", "--out": "out", "--policy": "policy",
-          "--scenario": "scenario", "--arm": "arm", "--bridge-params": "bridge_params", "--v2x": "v2x",
+          "--scenario": "scenario", "--arm": "arm", "--bridge-params": "bridge_params", "--rsu-params": "rsu_params", "--v2x": "v2x",
           "--sumo-output": "sumo_outputs"}
 FLAGS = {"--gui": ("gui", True), "--rviz": ("rviz", True), "--record": ("record", True),
          "--no-compare": ("compare", False), "--no-trajectories": ("trajectory_steps", 0)}
@@ -53,7 +53,7 @@ def check(argv):
     if p.get("scenario"):
         options.scenario_ok("--scenario", p.scenario)
     options.out_ok(p.get("out"))
-    for key, option in (("bridge_params", "--bridge-params"), ("v2x", "--v2x")):
+    for key, option in (("bridge_params", "--bridge-params"), ("rsu_params", "--rsu-params"), ("v2x", "--v2x")):
         p[key] = options.file_ok(option, p[key]) if p.get(key) else ""
     p["sumo_outputs"] = options.sumo_outputs_ok(p.sumo_outputs) if p.get("sumo_outputs") else ""
     arm = options.known_arm(p.arm, palcas_arms.ALL_ARMS) if p.get("arm") else ""
@@ -153,7 +153,8 @@ def run_arms(p, console, show, rviz):
               "seed:=%d" % p.seed, "duration:=" + p.duration, "gui:=" + flag(p.gui), "rviz:=false",
               "record:=" + flag(p.record), "trajectory_period_steps:=%d" % p.trajectory_steps,
               "real_time_factor:=" + p.real_time_factor, "auth_key_file:=" + auth_key,
-              "bridge_params:=" + (p.bridge_params or "none"), "v2x_params:=" + (p.v2x or "none"),
+              "bridge_params:=" + (p.bridge_params or "none"), "rsu_params:=" + (p.rsu_params or "none"),
+              "v2x_params:=" + (p.v2x or "none"),
               "sumo_outputs:=" + (p.sumo_outputs or "config"), "scenario:=" + p.scenario,
               "git_commit:=" + launch.git_commit(), "command_line:=" + p.command_line]
     if p.missing:
