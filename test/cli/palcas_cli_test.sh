@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Command-line checks of ./palcas: a bad option of `run` or `train` is refused with exit
-# status 2 and a message naming the option, before anything is installed, built or created.
+# Command-line checks of ./palcas: a bad option of `run`, `train`, `experiment` or `replay`
+# (--x y or --x=y) is refused with exit status 2 and a message naming the option, and --help
+# exits 0, before anything is installed, built or created.
 # Needs no build. `./palcas test` runs it and counts its JUnit file with the other tests.
 #
 #   test/cli/palcas_cli_test.sh [--xml FILE]
@@ -54,6 +55,10 @@ check() {
 }
 
 check run_pr_out_of_range      "--pr '150'"                 run --out "$OUT" --pr 150
+check run_pr_after_equals_sign "--pr '150'"                 run --out="$OUT" --pr=150
+check run_unknown_option       "run: unknown option '--bogus'" run --out "$OUT" --bogus
+check train_unknown_option     "train: unknown option '--bogus'" train --out "$OUT" --bogus
+check experiment_seeds_text    "experiment: argument --seeds: invalid int value: 'many'" experiment --out="$OUT" --seeds=many
 check run_seed_not_an_integer  "--seed 'x'"                 run --out "$OUT" --seed x
 check run_duration_not_positive "--duration '0'"            run --out "$OUT" --duration 0
 check run_scenario_unknown     "--scenario 'nope'"          run --out "$OUT" --scenario nope
@@ -111,6 +116,20 @@ check replay_unknown_option    "replay: unknown option '--bogus'" replay "$ANY_F
 check replay_rate_zero         "--rate '0'"                  replay "$ANY_FILE" --rviz --rate 0
 check replay_rate_without_rviz "--rate goes with --rviz"     replay "$ANY_FILE" --policy "$ROOT/policies/palcas" --rate 2
 check replay_rviz_with_policy  "it takes only --rate"        replay "$ANY_FILE" --rviz --policy "$ROOT/policies/palcas"
+
+# --help of every command: exit 0, every option with its default, nothing built or created.
+check_help() {  # COMMAND
+  local out status=0 why=""
+  out="$(cd "$WORK" && timeout -k 5 60 "$ROOT/palcas" "$1" --help 2>&1)" || status=$?
+  if [ "$status" -ne 0 ]; then why="exit status $status, expected 0: $out"
+  elif [[ "$out" != *"(default: "* ]]; then why="no defaults listed: $out"
+  elif [[ "$out" == *"building the workspace"* ]]; then why="started a build: $out"
+  elif [ -e "$PALCAS_RESULTS_DIR" ]; then why="created a results folder"
+  fi
+  names+=("$1_help"); failures+=("$why")
+  if [ -z "$why" ]; then echo "ok   $1_help"; else echo "FAIL $1_help: $why"; fi
+}
+for command in run train experiment replay; do check_help "$command"; done
 
 # --resume takes road, PR, seed and duration from the training record and refuses a flag
 # that contradicts it (a fake record: these checks stop before anything is built or run).

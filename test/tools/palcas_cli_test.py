@@ -11,6 +11,7 @@ import io
 import json
 import os
 import pathlib
+import re
 import shutil
 import signal
 import stat
@@ -23,7 +24,7 @@ import unittest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from palcas_cli import Console, commands, experiment, launch, options, run, train  # noqa: E402
+from palcas_cli import Console, commands, experiment, launch, options, replay, run, train  # noqa: E402
 from palcas_cli.options import OptionError  # noqa: E402
 import palcas_arms  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
@@ -122,10 +123,22 @@ class Options(unittest.TestCase):
         self.assertEqual(options.parse("run", ["--pr", "5", "--pr", "6"], values), {"pr": "6"})
         self.assertEqual(refusal(options.parse, "run", ["--pr", "--gui"], values, flags), "option --pr needs a value")
         self.assertEqual(refusal(options.parse, "run", ["--out"], values), "option --out needs a value")
-        self.assertEqual(refusal(options.parse, "run", ["bag"], values), "run: unknown option 'bag' (see ./palcas help)")
+        self.assertEqual(refusal(options.parse, "run", ["bag"], values), "run: unknown option 'bag' (see ./palcas run --help)")
+        self.assertEqual(refusal(options.parse, "run", ["--bogus=1"], values),
+                         "run: unknown option '--bogus=1' (see ./palcas run --help)")
+        self.assertEqual(refusal(options.parse, "run", ["--p", "5"], values), "run: unknown option '--p' (see ./palcas run --help)")
         words = []
-        options.parse("replay", ["a.bag", "-x"], values, positional=words.append)
-        self.assertEqual(words, ["a.bag", "-x"])
+        self.assertEqual(options.parse("replay", ["a.bag", "--pr", "5", "b.bag"], values, positional=words.append),
+                         {"pr": "5"})
+        self.assertEqual(words, ["a.bag", "b.bag"])
+        self.assertEqual(refusal(options.parse, "replay", ["a.bag", "-x"], values, None, (), words.append),
+                         "replay: unknown option '-x' (see ./palcas replay --help)")
+
+    def test_an_option_takes_its_value_after_an_equals_sign(self):
+        values, flags = {"--pr": "pr", "--demand": "demand"}, {"--gui": ("gui", True)}
+        self.assertEqual(options.parse("run", ["--pr=40", "--gui", "--demand=-5"], values, flags),
+                         {"pr": "40", "gui": True, "demand": "-5"})
+        self.assertEqual(options.parse("run", ["--demand", "-5"], values), {"demand": "-5"})  # a value, not an option
 
 
 class RunPlan(unittest.TestCase):
@@ -174,12 +187,99 @@ class Dispatch(unittest.TestCase):
 
     def test_a_bad_option_exits_2_naming_it(self):
         self.assertEqual(self.check("run", "--pr", "150"), (2, "[palcas] error: --pr '150': expected a number in [0, 100]\n"))
+        self.assertEqual(self.check("run", "--pr=150"), (2, "[palcas] error: --pr '150': expected a number in [0, 100]\n"))
         self.assertEqual(self.check("train", "--pr", "40", "--pr-range", "10,60"),
                          (2, "[palcas] error: --pr and --pr-range: give one of them\n"))
+        self.assertEqual(self.check("train", "--episodes=0"), (2, "[palcas] error: --episodes '0': expected an integer >= 1\n"))
         status, err = self.check("experiment", "--arms", "keep,bogus", "--out", "/tmp/x")
-        self.assertEqual((status, err.startswith("[experiment] error: --arms: unknown arm 'bogus'")), (2, True))
-        self.assertEqual(self.check("replay", "x.bag", "--bogus"), (2, "[palcas] error: replay: unknown option '--bogus' (see ./palcas help)\n"))
+        self.assertEqual((status, err.startswith("[palcas] error: --arms: unknown arm 'bogus'")), (2, True))
+        self.assertEqual(self.check("experiment", "--out", "/tmp/x", "--seeds", "many"),
+                         (2, "[palcas] error: experiment: argument --seeds: invalid int value: 'many' "
+                             "(see ./palcas experiment --help)\n"))
+        self.assertEqual(self.check("replay", "x.bag", "--bogus"),
+                         (2, "[palcas] error: replay: unknown option '--bogus' (see ./palcas replay --help)\n"))
+        self.assertEqual(self.check("replay", str(ROOT / "README.md"), "--accel-tolerance=tight", "--policy",
+                                    str(ROOT / "policies" / "palcas")),
+                         (2, "[palcas] error: --accel-tolerance 'tight': expected a number greater than 0\n"))
         self.assertEqual(self.check("bogus")[0], 2)
+
+    def test_every_command_errs_with_one_prefix(self):
+        for argv in (["run", "--bogus"], ["train", "--bogus"], ["experiment", "--bogus", "--out", "/tmp/x"],
+                     ["replay", "x.bag", "--bogus"], ["run", "--pr"], ["experiment", "--arms", "keep"]):
+            with self.subTest(argv=argv):
+                status, err = self.check(*argv)
+                self.assertEqual(status, 2)
+                self.assertTrue(err.startswith("[palcas] error: "), err)
+                self.assertEqual(err.count("\n"), 1, err)
+
+    def test_an_option_value_after_an_equals_sign(self):
+        self.assertEqual(self.check("run", "--arm=keep", "--pr=40"), (commands.BUILD, ""))
+        self.assertEqual(run.check(["--arm=keep", "--pr=40", "--sumo-output=fcd", "--sumo-output=ssm"]).pr, "40")
+        self.assertEqual(run.check(["--arm", "keep", "--pr=40"]).command_line, "./palcas run --arm keep --pr=40")
+        opts = train.check(["--pr=40", "--episodes=2", "--demand-range=1000,1400"])[0]
+        self.assertEqual((opts["pr"], opts["episodes"], opts["demand_range"]), (40.0, 2, [1000, 1400]))
+        with tempfile.TemporaryDirectory() as d:
+            self.assertEqual(self.check("experiment", "--plan", "--arms=keep", "--prs=40", "--out=" + d)[0],
+                             commands.NO_BUILD)
+
+
+class Help(unittest.TestCase):
+    """--help of every command exits 0 and lists every option with its default; `check` with
+    --help needs no build (./palcas then runs the command, which prints the help)."""
+    # Every option of each command, and defaults its help must name.
+    EXPERIMENT_OPTIONS = ("--out", "--plan", "--collect", "--point", "--arms", "--prs", "--demands", "--seeds",
+                          "--seed-set", "--duration", "--scenario", "--v2x", "--rsu-params", "--bridge-params",
+                          "--policy", "--jobs")
+    DEFAULTS = {"run": {"--duration": "1800", "--pr": "60", "--seed": "101", "--arm": "palcas"},
+                "train": {"--episodes": "5", "--duration": "3600", "--pr": "60", "--seed": "1",
+                          "--explore-fraction": "0.5", "--arm": "palcas", "--scenario": "paper"},
+                "experiment": {"--arms": "palcas,keep,sumo_native", "--prs": "5,10,20,40,60", "--seeds": "3",
+                               "--seed-set": "test", "--duration": "1800", "--scenario": "paper"},
+                "replay": {"--accel-tolerance": "0.001", "--rate": "1"}}
+
+    def help_of(self, command):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+            with self.assertRaises(SystemExit) as stop:
+                commands.main([command, "--help"])
+        self.assertIn(stop.exception.code, (0, None))
+        return out.getvalue()
+
+    @staticmethod
+    def option_blocks(text):
+        """{option: its lines of help} from argparse's options section."""
+        blocks, current = {}, None
+        for line in text.split("options:", 1)[1].splitlines():
+            words = line.split()
+            if line.startswith("  -") and words:
+                current = words[-1 if words[0] == "-h," else 0].rstrip(",")
+                blocks[current] = line
+            elif current:
+                blocks[current] += " " + line.strip()
+        return blocks
+
+    def options_of(self, command):
+        if command == "experiment":
+            return self.EXPERIMENT_OPTIONS
+        module = {"run": run, "train": train, "replay": replay}[command]
+        return tuple(module.VALUES) + tuple(module.FLAGS)
+
+    def test_help_exits_0_and_lists_every_option_with_its_default(self):
+        for command in commands.COMMANDS:
+            with self.subTest(command=command):
+                blocks = self.option_blocks(self.help_of(command))
+                for option in self.options_of(command):
+                    self.assertIn(option, blocks, "%s --help does not list %s" % (command, option))
+                    self.assertIn("(default: ", blocks[option], "%s --help: %s has no default" % (command, option))
+                for option, default in self.DEFAULTS[command].items():
+                    self.assertRegex(blocks[option], r"\(default: [^)]*\b%s\b" % re.escape(default),
+                                     "%s --help: %s" % (command, option))
+
+    def test_check_with_help_builds_nothing(self):
+        for command in commands.COMMANDS:
+            with self.subTest(command=command):
+                with contextlib.redirect_stdout(io.StringIO()):
+                    self.assertEqual(commands.main(["check", command, "--help"]), commands.NO_BUILD)
 
 
 class ConsoleLog(unittest.TestCase):

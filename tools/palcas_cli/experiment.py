@@ -23,7 +23,6 @@ default test): settings are chosen on dev (101-130), results are reported on tes
 (1001-1030), never tuned on. experiment.json records the set (seed_set); a folder is extended
 only with seeds of its own set. A seed a policy trained on is refused either way.
 """
-import argparse
 import concurrent.futures
 import json
 import os
@@ -52,7 +51,6 @@ POINT_FILES = (("v2x", "--v2x"), ("bridge_params", "--bridge-params"), ("rsu_par
 
 class UsageError(OptionError):
     """A bad command line of the experiment (exit 2, nothing written)."""
-    prefix = "[experiment]"
 
 
 def parse_list(text, what, convert):
@@ -374,57 +372,66 @@ def run_all(out, settings, jobs):
 
 
 def common_options(p):
-    p.add_argument("--out", required=True)
-    p.add_argument("--arms", default="palcas,keep,sumo_native")
-    p.add_argument("--prs", default=",".join(str(x) for x in PAPER_PRS))
-    p.add_argument("--demands", default=None,
-                   help="mainline demands [veh/h per lane]; default: the scenario's own")
-    p.add_argument("--seeds", type=int, default=3,
-                   help="the first N seeds of the seed set (default 3)")
+    D = options.with_default
+    p.add_argument("--arms", default="palcas,keep,sumo_native", metavar="A,B,...",
+                   help=D("arms to run (any arm of config/arms.json)", "%(default)s"))
+    p.add_argument("--prs", default=",".join(str(x) for x in PAPER_PRS), metavar="P,P,...",
+                   help=D("CAV penetration rates [%%]", "the paper's %(default)s"))
+    p.add_argument("--demands", default=None, metavar="D,D,...",
+                   help=D("mainline demands [veh/h per lane], a dimension beside arms, PRs and seeds; "
+                          "--collect then also draws figures/capacity.png", "the scenario's own"))
+    p.add_argument("--seeds", type=int, default=3, metavar="N",
+                   help=D("the first N seeds of the seed set (a policy's training seeds are refused)",
+                          "%(default)s"))
     p.add_argument("--seed-set", dest="seed_set", default=seed_sets.DEFAULT, metavar="dev|test",
-                   help="a set of config/seeds.yaml: dev (settings are chosen on it) or test "
-                        "(reporting only; default)")
-    p.add_argument("--duration", type=float, default=1800.0)
-    p.add_argument("--scenario", default="paper")
-    p.add_argument("--v2x", default="", metavar="FILE", help="the V2X channel for every point (./palcas run --v2x)")
+                   help=D("a set of config/seeds.yaml: dev (settings are chosen on it) or test (reporting "
+                          "only); an experiment folder keeps its set", "%(default)s"))
+    p.add_argument("--duration", type=float, default=1800.0, metavar="SECONDS",
+                   help=D("simulated time per point", "%(default)g"))
+    p.add_argument("--scenario", default="paper", metavar="NAME",
+                   help=D("road under config/scenarios", "%(default)s"))
+    p.add_argument("--v2x", default="", metavar="FILE",
+                   help=D("the V2X channel for every point (./palcas run --v2x)", "off"))
     p.add_argument("--rsu-params", dest="rsu_params", default="", metavar="FILE",
-                   help="an RSU parameter override for every point (./palcas run --rsu-params)")
+                   help=D("an RSU parameter override for every point (./palcas run --rsu-params)", "none"))
     p.add_argument("--bridge-params", dest="bridge_params", default="", metavar="FILE",
-                   help="a bridge parameter override for every point (./palcas run --bridge-params)")
-    p.add_argument("--policy", action="append", metavar="ARM=DIR")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-
-
-class Parser(argparse.ArgumentParser):
-    def error(self, message):
-        raise UsageError(message)
+                   help=D("a bridge parameter override for every point (./palcas run --bridge-params)", "none"))
+    p.add_argument("--policy", action="append", metavar="ARM=DIR",
+                   help=D("a policy for a learning arm (repeatable)", "policies/<arm>/"))
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="J",
+                   help=D("points at a time", "the machine's cores, %(default)s"))
 
 
 MODES = {"--plan": "plan", "--collect": "collect"}
 
 
 def parse(argv):
-    """./palcas experiment's command line as (mode, options): run, plan, collect or point."""
-    mode, rest, words = "run", [], list(argv)
-    while words:
-        word = words.pop(0)
+    """./palcas experiment's command line as (mode, options): run, plan, collect or point.
+    --help (any mode) lists every option with its default."""
+    mode, words = "run", list(argv)
+    for word in words:
         if word in MODES:
             mode = MODES[word]
-        elif word == "--point":
+        elif word == "--point" or word.startswith("--point="):
             mode = "point"
-            rest += ["--name"] + words[:1]
-            words = words[1:]
-        else:
-            rest.append(word)
-    ap = Parser(prog="./palcas experiment", description=__doc__,
-                formatter_class=argparse.RawDescriptionHelpFormatter)
+    if "-h" in words or "--help" in words:
+        mode = "run"  # the whole list of options
+    ap = options.Parser("experiment", description=__doc__)
+    D = options.with_default
+    ap.add_argument("--out", required=True, metavar="DIR",
+                    help=D("the experiment folder; run the same command again to continue", "none: required"))
+    ap.add_argument("--plan", action="store_true",
+                    help=D("write DIR/plan.txt (a command per point) and DIR/slurm_array.sh only", "off"))
+    ap.add_argument("--collect", action="store_true",
+                    help=D("tables and figures from DIR's point folders, wherever they ran", "off"))
+    ap.add_argument("--point", dest="name", metavar="NAME",
+                    help=D("run one planned point (what plan.txt calls)", "none"))
     if mode in ("run", "plan"):
         common_options(ap)
-    else:
-        ap.add_argument("--out", required=True)
-        if mode == "point":
-            ap.add_argument("--name", required=True)
-    return mode, ap.parse_args(rest)
+    a, extra = ap.parse_known_args(words)
+    for word in extra:
+        ap.unknown(word)
+    return mode, a
 
 
 def check(argv):
@@ -451,7 +458,7 @@ def main(argv):
     try:
         return experiment(*check(argv))
     except KeyboardInterrupt:
-        print("[experiment] interrupted: finished points are kept; rerun the same command to "
+        print("[palcas] interrupted: finished points are kept; rerun the same command to "
               "continue", file=sys.stderr)
         return 130
 
@@ -474,7 +481,7 @@ def experiment(mode, a, out, settings):
     failed = run_all(out, settings, a.jobs)
     code = experiment_results.collect(out, settings, points_of(settings))
     if failed:
-        print(f"[experiment] error: {len(failed)} point(s) failed: {', '.join(failed)} "
+        print(f"[palcas] error: {len(failed)} point(s) failed: {', '.join(failed)} "
               f"(see their point.json; rerun the same command to retry them)", file=sys.stderr)
         return 1
     return code

@@ -2,6 +2,7 @@
 built or created. Each checker returns the value in normal form or raises OptionError
 naming the option and the value (`./palcas` exits 2 with it). Standard library only, plus
 PyYAML for the few checks that read a road's scenario.yaml (imported where needed)."""
+import argparse
 import os
 import pathlib
 import re
@@ -32,26 +33,85 @@ def normal(value):
     return "%.10g" % float(value)
 
 
-def parse(command, argv, values, flags=None, joined=(), positional=None):
-    """The options of a command line: VALUES maps an option to the key its value goes to,
-    FLAGS an option to (key, value); a JOINED key collects its values comma-separated (else
-    the last one counts); a word that is no option goes to positional(word), if the command
-    takes one. Returns {key: value} of what was given."""
-    given, words, flags = {}, list(argv), flags or {}
-    while words:
-        word = words.pop(0)
-        if word in values:
-            if not words or words[0].startswith("--"):
-                raise OptionError("option %s needs a value" % word)
-            key, value = values[word], words.pop(0)
-            given[key] = given[key] + "," + value if key in joined and given.get(key) else value
-        elif word in flags:
-            key, value = flags[word]
-            given[key] = value
-        elif positional and not word.startswith("--"):
-            positional(word)
+class HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """The description as written; each option's help wrapped beside it."""
+
+    def __init__(self, prog):
+        super().__init__(prog, max_help_position=32, width=100)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse for every command: --help lists each option with its default and exits 0,
+    --x=y works, and a bad command line is an OptionError (exit 2, "[palcas] error: ...")
+    instead of argparse's own message and exit."""
+
+    def __init__(self, command, description=None):
+        super().__init__(prog="./palcas " + command, description=description, allow_abbrev=False,
+                         formatter_class=HelpFormatter)
+        self.command = command
+
+    def error(self, message):
+        needs = re.match(r"argument (--[A-Za-z0-9-]+)(/\S+)?: expected one argument$", message)
+        if needs:
+            raise OptionError("option %s needs a value" % needs.group(1))
+        raise OptionError("%s: %s (see ./palcas %s --help)" % (self.command, message, self.command))
+
+    def unknown(self, word):
+        raise OptionError("%s: unknown option '%s' (see ./palcas %s --help)" % (self.command, word, self.command))
+
+
+def with_default(text, default):
+    """An option's help: what it does, then its default (argparse's %-escapes kept)."""
+    return "%s (default: %s)" % (text, default)
+
+
+def parser(command, values, flags=None, joined=(), helps=None, description=None, positional=None):
+    """The argparse parser of a command: VALUES maps an option to the key its value goes to,
+    FLAGS an option to (key, value); a JOINED key collects its values; HELPS maps an option
+    to (METAVAR, help with its default) (a flag's METAVAR is None). Nothing has an argparse
+    default, so parsing gives only what was given; POSITIONAL (a name) takes the words that
+    are no option."""
+    ap, flags, helps = Parser(command, description), flags or {}, helps or {}
+    if positional:
+        ap.add_argument("words", nargs="?", metavar=positional, help=helps.get(positional, (None, ""))[1])
+    # --help lists the options in HELPS's order, then any it does not describe.
+    for option in [o for o in helps if o in values or o in flags] + [
+            o for o in list(values) + list(flags) if o not in helps]:
+        if option in values:
+            key = values[option]
+            metavar, text = helps.get(option, (key.upper(), ""))
+            ap.add_argument(option, dest=key, metavar=metavar, help=text, default=argparse.SUPPRESS,
+                            action="append" if key in joined else "store")
         else:
-            raise OptionError("%s: unknown option '%s' (see ./palcas help)" % (command, word))
+            key, value = flags[option]
+            ap.add_argument(option, dest=key, action="store_const", const=value, default=argparse.SUPPRESS,
+                            help=helps.get(option, (None, ""))[1])
+    return ap
+
+
+def parse(command, argv, values, flags=None, joined=(), positional=None, helps=None, description=None,
+          positional_name="WORD"):
+    """The options of a command line (parser() says what the tables hold): returns {key: value}
+    of what was given; a JOINED key's values come comma-separated (else the last one counts); a
+    word that is no option goes to positional(word), if the command takes one (shown in --help
+    as POSITIONAL_NAME). --help prints the options with their defaults and exits 0 (SystemExit)."""
+    ap = parser(command, values, flags, joined, helps, description, positional_name if positional else None)
+    known, extra = ap.parse_known_args(list(argv))
+    given = vars(known)
+    words = [given.pop("words")] if given.get("words") is not None else []
+    given.pop("words", None)
+    for word in extra:  # words after the first option's value, and unknown options
+        if positional and not word.startswith("-"):
+            words.append(word)
+        else:
+            ap.unknown(word)
+    for key in joined:
+        if key in given:
+            given[key] = ",".join(given[key])
+    for word in words:
+        if not positional:
+            ap.unknown(word)
+        positional(word)
     return given
 
 

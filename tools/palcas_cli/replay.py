@@ -18,6 +18,25 @@ from palcas_cli.options import OptionError
 VALUES = {"--rate": "rate", "--policy": "policy", "--csv": "csv", "--learning": "learning",
           "--rsu-params": "rsu_params", "--accel-tolerance": "tolerance"}
 FLAGS = {"--rviz": ("rviz", True), "--paper-printed": ("paper_printed", True)}
+D = options.with_default
+# --help: each option's METAVAR (None for a flag) and what it does, with its default.
+HELPS = {
+    "BAG": (None, "the recorded episode (./palcas run --record: <run>/<arm>/episode.bag)"),
+    "--policy": ("DIR", D("a training's checkpoints/ folder, a policy folder holding one, or a ./palcas train "
+                          "folder (its learning override comes along); required without --rviz", "none")),
+    "--csv": ("FILE", D("the disagreements", "BAG's name with .replay.csv")),
+    "--learning": ("FILE", D("the \"learning:\" override the policy was trained with",
+                             "the train folder's, else none")),
+    "--rsu-params": ("FILE", D("an RSU parameter override the recorded run used", "none")),
+    "--paper-printed": (None, D("the recorded run used paper_printed:=true", "off, or the train folder's")),
+    "--accel-tolerance": ("X", D("ACCELERATE advisories agree within X m/s^2", "0.001")),
+    "--rviz": (None, D("play the bag (and episode_view.bag beside it) into rviz instead; takes only --rate",
+                       "off")),
+    "--rate": ("X", D("with --rviz: X times as fast as simulated time", "1")),
+}
+DESCRIPTION = ("replay BAG --policy DIR: the policy's RSUs decide open loop on the vehicle and cluster states "
+               "recorded\nin BAG, and their advisories are compared with the recorded ones (exits 0 whenever "
+               "it ran).\nreplay BAG --rviz [--rate X]: the bag played into rviz on the run's framed view.")
 # Per RSU or per run, set again by the replay itself or meaningless in it.
 NOT_REPLAYED = ("checkpoint_dir", "resume", "policy_dir", "auth_key_file")
 NS = "/replay_policy/"
@@ -32,7 +51,8 @@ def check(argv):
             raise OptionError("replay: one bag only ('%s', then '%s')" % (bags[0], word))
         bags.append(word)
 
-    o = options.parse("replay", argv, VALUES, FLAGS, positional=bag_word)
+    o = options.parse("replay", argv, VALUES, FLAGS, positional=bag_word, helps=HELPS, description=DESCRIPTION,
+                      positional_name="BAG")
     if not bags:
         raise OptionError("replay: no bag given (./palcas replay BAG --policy DIR)")
     o["bag"] = bags[0]

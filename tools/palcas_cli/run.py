@@ -26,6 +26,42 @@ FLAGS = {"--gui": ("gui", True), "--rviz": ("rviz", True), "--record": ("record"
          "--no-compare": ("compare", False), "--no-trajectories": ("trajectory_steps", 0)}
 DEFAULTS = {"duration": "1800", "pr": "60", "seed": "101", "gui": False, "rviz": False, "record": False,
             "compare": True, "trajectory_steps": 10}
+D = options.with_default
+# --help: each option's METAVAR (None for a flag) and what it does, with its default.
+HELPS = {
+    "--arm": ("A", D("only this arm (plus keep and sumo_native to compare); a learning arm's policy comes "
+                     "from policies/<A>/ or --policy", "palcas, with the shipped policy")),
+    "--policy": ("DIR", D("evaluate this trained policy (a ./palcas train folder) instead", "policies/<arm>/")),
+    "--no-compare": (None, D("leave out the keep and sumo_native columns", "off: they are compared")),
+    "--duration": ("SECONDS", D("simulated time per arm", DEFAULTS["duration"])),
+    "--pr": ("PERCENT", D("CAV penetration rate in [0, 100]", DEFAULTS["pr"])),
+    "--demand": ("VPHPL", D("mainline demand [veh/h per lane] in [0, %d]" % options.MAX_DEMAND,
+                            "the scenario's mainline_flow_vphpl")),
+    "--ramp-demand": ("VPH", D("on-ramp demand [veh/h per ramp] in [0, %d]" % options.MAX_DEMAND,
+                               "the scenario's onramp_flow_vphpl")),
+    "--seed": ("N", D("random seed; the shipped policies never trained on 101", DEFAULTS["seed"])),
+    "--scenario": ("NAME", D("road under config/scenarios, or an absolute path to a folder with scenario.yaml",
+                             "the policy's road, else paper")),
+    "--out": ("DIR", D("run folder", "results/run-<time>-pr<P>-d<demand>-s<N>")),
+    "--gui": (None, D("attach an external sumo-gui through libtraci", "off")),
+    "--rviz": (None, D("watch each arm in rviz, framed on its road; the last arm's window stays open until "
+                       "you close it", "off")),
+    "--real-time-factor": ("X", D("simulate at most X times faster than wall time (X > 0)",
+                                  "1 with --rviz, else as fast as possible")),
+    "--record": (None, D("record a rosbag of each run into its folder", "off")),
+    "--no-trajectories": (None, D("record no trajectories.csv / decisions.csv (and draw no figures)",
+                                  "off: every %d steps" % DEFAULTS["trajectory_steps"])),
+    "--bridge-params": ("FILE", D("a bridge parameter override for every arm", "none")),
+    "--rsu-params": ("FILE", D("an RSU parameter override for every RSU (e.g. a rules: map over "
+                               "config/rules.yaml)", "none")),
+    "--v2x": ("FILE", D("the V2X channel over config/v2x.yaml (e.g. config/v2x/impaired_100ms_10pct.yaml)",
+                        "off")),
+    "--sumo-output": ("NAMES", D("SUMO's own outputs into each arm's folder as sumo_<name>.xml, comma-separated "
+                                 "(repeatable): " + " ".join(options.SUMO_OUTPUTS), "config/bridge.yaml's")),
+}
+DESCRIPTION = ("Every arm on the same traffic, one launch each: the shipped trained policy, keep and "
+               "sumo_native;\none metric table with a column per arm. Exits non-zero if any arm wrote no "
+               "metrics.json.")
 # matplotlib draws one figure at a time in a process (an experiment runs points in threads).
 FIGURES_LOCK = threading.Lock()
 
@@ -37,7 +73,8 @@ class Plan(dict):
 
 def check(argv):
     """The run's plan from its command line; raises OptionError naming a bad option."""
-    given = options.parse("run", argv, VALUES, FLAGS, joined=("sumo_outputs",))
+    given = options.parse("run", argv, VALUES, FLAGS, joined=("sumo_outputs",), helps=HELPS,
+                          description=DESCRIPTION)
     p = Plan(DEFAULTS, **given)
     p["command_line"] = "./palcas run " + " ".join(argv)
     p["duration"] = options.number_in("--duration", p.duration, 0, None, open_low=True)

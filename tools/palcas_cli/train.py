@@ -51,6 +51,42 @@ VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "-
           "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
           "--v2x": "v2x_params"}
 FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True)}
+# A new training's defaults as typed (DEFAULTS's values, 3600.0 as 3600).
+TYPED_DEFAULTS = {k: v if isinstance(v, str) else "%g" % v for k, v in DEFAULTS.items()
+                  if k in ("episodes", "duration", "pr", "seed", "explore_fraction", "arm", "scenario")}
+D = options.with_default
+# --help: each option's METAVAR (None for a flag) and what it does, with its default.
+HELPS = {
+    "--arm": ("A", D("a learning arm of config/arms.json", TYPED_DEFAULTS["arm"])),
+    "--episodes": ("N", D("episodes (--resume: may raise the count)", TYPED_DEFAULTS["episodes"])),
+    "--duration": ("SECONDS", D("simulated time per episode", TYPED_DEFAULTS["duration"])),
+    "--pr": ("PERCENT", D("CAV penetration rate in [0, 100]", TYPED_DEFAULTS["pr"])),
+    "--pr-range": ("MIN,MAX", D("each episode draws its PR uniformly from [MIN, MAX] (instead of --pr); the "
+                                "draws follow from --seed and are recorded in train.json", "none")),
+    "--demand": ("VPHPL", D("mainline demand [veh/h per lane] of every episode, in [0, %d]" % options.MAX_DEMAND,
+                            "the scenario's")),
+    "--demand-range": ("MIN,MAX", D("each episode draws its mainline demand uniformly from [MIN, MAX] "
+                                    "(instead of --demand)", "none")),
+    "--ramp-demand": ("VPH", D("on-ramp demand [veh/h per ramp] of every episode", "the scenario's")),
+    "--seed": ("N", D("random seed of the first episode (episode k: seed + k)", TYPED_DEFAULTS["seed"])),
+    "--scenario": ("NAME", D("road under config/scenarios, or an absolute path to a folder with scenario.yaml",
+                             TYPED_DEFAULTS["scenario"])),
+    "--explore-fraction": ("F", D("share of the training over which exploration decays, in (0, 1]",
+                                  TYPED_DEFAULTS["explore_fraction"])),
+    "--out": ("DIR", D("training folder", "results/train-<arm>-<time>")),
+    "--paper-printed": (None, D("every constant as the paper prints it", "off")),
+    "--learning": ("FILE", D("a \"learning:\" YAML override for RSUs and server alike "
+                             "(e.g. config/training/short_learning.yaml)", "none")),
+    "--rsu-params": ("FILE", D("an RSU parameter override (e.g. config/training/short_rsu.yaml)", "none")),
+    "--bridge-params": ("FILE", D("a bridge parameter override (e.g. config/training/unclipped_advisories.yaml)",
+                                  "none")),
+    "--v2x": ("FILE", D("train with the V2X channel on (as for run)", "off")),
+    "--resume": (None, D("continue the training in --out from its checkpoints; road, arm, PR, seed, duration "
+                         "and overrides come from its train.json (a contradicting option is refused)", "off")),
+}
+DESCRIPTION = ("Train an arm: progress on the terminal, learning curves, resumable (--resume). Exit status: "
+               "0 done,\n1 a node died for good or nothing was trained, 2 a bad option, 130 / 143 "
+               "interrupted.")
 console = Console()
 
 
@@ -317,9 +353,8 @@ def check(argv):
     """The training's options from its command line: (opts, record, out, resume); a resumed
     training takes what was not given from its record (record: None for a new one). Raises
     OptionError naming a bad option, before anything is made or started."""
-    given = options.parse("train", argv, VALUES, FLAGS)
-    value = dict({"episodes": "5", "duration": "3600", "pr": "60", "seed": "1", "explore_fraction": "0.5",
-                  "arm": "palcas", "scenario": "paper"}, **given)
+    given = options.parse("train", argv, VALUES, FLAGS, helps=HELPS, description=DESCRIPTION)
+    value = dict(TYPED_DEFAULTS, **given)
     settled = {"episodes": options.integer_in("--episodes", value["episodes"], 1),
                "duration": float(options.number_in("--duration", value["duration"], 0, None, open_low=True)),
                "pr": float(options.number_in("--pr", value["pr"], 0, 100)),
