@@ -7,9 +7,16 @@
   dependency;
 - every `pkg="..."` a launch file starts is a run dependency (<depend> or <exec_depend>) of
   the package holding that launch file; test launch files' packages are test dependencies;
+- every third-party module a package's Python imports is one of its dependencies (tools/,
+  not a catkin package, counts as palcas_launch's: its commands start those launches);
+- every rosdep key a package.xml names resolves: a package of this repository, or a key of
+  rosdep/keys.yaml (Debian's rules, rosdistro's, rosdep/palcas.yaml's), checked against
+  Debian's rules file where python3-rosdep2 is installed; the repository's LICENSE is the
+  license every package.xml names;
 - palcas_core's CMake extras export the flags it was built with;
 - a plain `catkin_make` at the repository root stops and names the command that works.
 """
+import ast
 import os
 import pathlib
 import re
@@ -19,21 +26,37 @@ import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
+import yaml
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "test" / "tools"))
 from junit_runner import run_as_junit  # noqa: E402
 
 PACKAGE_DIRS = ["src", "palcas_msgs", "palcas_common", "palcas_rsu", "palcas_fedserver",
-                "palcas_sumo_bridge", "launch", "config", "test"]
+                "palcas_sumo_bridge", "launch", "config", "policies", "test"]
 # find_package names that are not ROS package names -> their rosdep key.
-ROSDEP = {"Eigen3": "eigen", "OpenSSL": "libssl-dev", "nlohmann_json": "nlohmann-json3-dev",
+ROSDEP = {"Eigen3": "eigen", "OpenSSL": "libssl-dev", "nlohmann_json": "nlohmann-json-dev",
           "GTest": "gtest", "rostest": "rostest", "catkin": None, "OpenMP": None}
 # Include prefixes that are no ROS package: the C++ and system libraries, or inside another.
 NOT_PACKAGES = {"sys", "openssl", "nlohmann", "gtest", "ros", "xmlrpcpp", "libsumo", "Eigen",
                 "benchmark", "boost", "gmock"}
 # A header folder that belongs to another package.
-INCLUDE_PACKAGE = {"libsumo": "sumo", "nlohmann": "nlohmann-json3-dev", "openssl": "libssl-dev",
+INCLUDE_PACKAGE = {"libsumo": "sumo", "nlohmann": "nlohmann-json-dev", "openssl": "libssl-dev",
                    "ros": "roscpp", "xmlrpcpp": "roscpp"}
+
+
+# Every tag of package format 2 that names a rosdep key.
+DEPEND_TAGS = ("depend", "build_depend", "build_export_depend", "buildtool_depend", "buildtool_export_depend",
+               "exec_depend", "test_depend", "doc_depend")
+# The rules rosdep resolves keys with: Debian's own (python3-rosdep2), and the keys of this
+# repository's package.xml files resolved by rosdistro's and rosdep/palcas.yaml's (committed).
+DEBIAN_RULES = pathlib.Path("/usr/share/python3-rosdep2/debian.yaml")
+KEYS_FILE = ROOT / "rosdep" / "keys.yaml"
+# Python modules whose rosdep key is not their name (a ROS package's module is its name).
+MODULE_KEYS = {"yaml": "python3-yaml", "numpy": "python3-numpy", "matplotlib": "python3-matplotlib",
+               "PIL": "python3-pil", "scipy": "python3-scipy", "rospkg": "python3-rospkg"}
+# Python that is no package's own: whose dependencies it counts as (run or test).
+PYTHON_OWNERS = {"tools": ("launch", "run")}
 
 
 def manifest(folder):
@@ -56,6 +79,52 @@ def sources(folder):
         for f in (ROOT / folder).rglob(ext):
             if f.name != "no_ros_headers_test.cpp":  # names ROS headers to prove none is used
                 yield f
+
+
+def all_keys(folder):
+    """{key: [tags]} of every dependency a package.xml names."""
+    root = ET.parse(ROOT / folder / "package.xml").getroot()
+    keys = {}
+    for tag in DEPEND_TAGS:
+        for e in root.findall(tag):
+            keys.setdefault(e.text.strip(), []).append(tag)
+    return keys
+
+
+def package_folders():
+    """Every folder of the repository with a package.xml (the catkin source space)."""
+    return sorted(p.parent.name for p in ROOT.glob("*/package.xml"))
+
+
+def python_imports(path):
+    """Top-level modules a Python file imports, except those imported only under a `try`
+    that catches ImportError (optional ones)."""
+    tree = ast.parse(path.read_text())
+    optional = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Try) and any(
+                h.type is None or "ImportError" in ast.dump(h.type) or "Exception" in ast.dump(h.type)
+                for h in node.handlers):
+            for inner in node.body:
+                for n in ast.walk(inner):
+                    if isinstance(n, (ast.Import, ast.ImportFrom)):
+                        optional.add(id(n))
+    found = set()
+    for n in ast.walk(tree):
+        if id(n) in optional:
+            continue
+        if isinstance(n, ast.Import):
+            found |= {a.name.split(".")[0] for a in n.names}
+        elif isinstance(n, ast.ImportFrom) and n.level == 0 and n.module:
+            found.add(n.module.split(".")[0])
+    return found
+
+
+def local_modules():
+    """Modules of this repository (a .py file or a package folder): imported from a path."""
+    files = [f for f in ROOT.rglob("*.py") if not {"build", "devel", "install", ".git"} & set(
+        f.relative_to(ROOT).parts)]
+    return {f.stem for f in files} | {f.parent.name for f in files if f.name == "__init__.py"}
 
 
 class PackageDepsTest(unittest.TestCase):
@@ -103,6 +172,74 @@ class PackageDepsTest(unittest.TestCase):
                         if pkg != name and pkg not in everything:
                             missing.add("%s (%s)" % (pkg, f.relative_to(ROOT)))
                 self.assertEqual(sorted(missing), [], "%s/package.xml lacks what it launches" % folder)
+
+    def test_python_imports_are_dependencies(self):
+        local, std = local_modules(), set(sys.stdlib_module_names)
+        owners = {f: (f, None) for f in package_folders()}
+        owners.update(PYTHON_OWNERS)
+        for folder, (package_folder, kind) in sorted(owners.items()):
+            name, _, run, everything = manifest(package_folder)
+            with self.subTest(folder=folder, package=name):
+                missing = set()
+                for f in sorted((ROOT / folder).rglob("*.py")):
+                    rel = f.relative_to(ROOT / folder)
+                    # A package's tests (and the palcas_tests package) may use test dependencies.
+                    testing = kind != "run" and (folder == "test" or "test" in rel.parts)
+                    for module in python_imports(f) - std - local:
+                        key = MODULE_KEYS.get(module, module)
+                        if key != name and key not in (everything if testing else run):
+                            missing.add("%s (%s: import %s)" % (key, f.relative_to(ROOT), module))
+                self.assertEqual(sorted(missing), [], "%s/package.xml lacks what its Python imports" % package_folder)
+
+    def test_every_rosdep_key_resolves(self):
+        names = {manifest(f)[0] for f in package_folders()}
+        listed = yaml.safe_load(KEYS_FILE.read_text())
+        known = {k: v for section in listed.values() for k, v in section.items()}
+        used = set()
+        for folder in package_folders():
+            used |= set(all_keys(folder)) - names
+            with self.subTest(package=folder):
+                unknown = sorted(k for k in all_keys(folder) if k not in names and k not in known)
+                self.assertEqual(unknown, [], "%s/package.xml names rosdep keys rosdep cannot resolve (not in "
+                                 "rosdep/keys.yaml; a Debian package name is not always its key)" % folder)
+        self.assertEqual(sorted(set(known) - used), [], "rosdep/keys.yaml lists keys no package.xml names")
+        own = yaml.safe_load((ROOT / "rosdep" / "palcas.yaml").read_text())
+        self.assertEqual({k: v["debian"] for k, v in own.items()}, listed["palcas"],
+                         "rosdep/keys.yaml's palcas keys are not rosdep/palcas.yaml's rules")
+
+    def test_debians_rules_resolve_the_listed_keys_alike(self):
+        if not DEBIAN_RULES.exists():
+            self.skipTest("python3-rosdep2 is not installed: rosdep/keys.yaml stands for its rules")
+        rules = yaml.safe_load(DEBIAN_RULES.read_text())
+        listed = yaml.safe_load(KEYS_FILE.read_text())
+        for key, packages in listed["debian_rosdep"].items():
+            self.assertIn(key, rules, "%s: no key of %s" % (key, DEBIAN_RULES))
+            self.assertEqual(rules[key].get("debian"), packages, "%s resolves otherwise in %s" % (key, DEBIAN_RULES))
+        for section in ("rosdistro", "palcas"):
+            for key in listed[section]:
+                # Debian's rules come first in rosdep's sources: they would decide this key.
+                self.assertNotIn(key, rules, "%s is a key of %s, not of %s" % (key, DEBIAN_RULES, section))
+
+    def test_palcas_installs_what_the_keys_resolve_to(self):
+        # ./palcas installs each Debian package some key resolves to, or a tool around the
+        # build (TOOLS); a package nothing names (as libtf2-geometry-msgs-dev was) is refused.
+        tools = {"build-essential": "compilers", "cmake": "catkin_make", "ros-core-dev": "roscore, roslaunch",
+                 "rosbash": "rosrun"}
+        script = (ROOT / "palcas").read_text()
+        installed = re.search(r"^DEBIAN_PACKAGES=\(([^)]*)\)", script, re.M).group(1).split()
+        listed = yaml.safe_load(KEYS_FILE.read_text())
+        resolved = {p for section in listed.values() for packages in section.values() for p in packages}
+        self.assertEqual(sorted(p for p in installed if p not in resolved and p not in tools), [],
+                         "./palcas installs Debian packages no rosdep key of a package.xml resolves to")
+
+    def test_the_license_every_package_names_is_the_repositorys(self):
+        text = (ROOT / "LICENSE").read_text()
+        self.assertTrue(text.startswith("BSD 3-Clause License"), "LICENSE is not the BSD 3-Clause text")
+        self.assertIn("Copyright (c) 2026, the PALCAS authors", text)
+        for folder in package_folders():
+            with self.subTest(package=folder):
+                root = ET.parse(ROOT / folder / "package.xml").getroot()
+                self.assertEqual([e.text.strip() for e in root.findall("license")], ["BSD-3-Clause"])
 
     def test_palcas_core_exports_its_flags(self):
         # A package built against palcas_core's headers elsewhere (an install space, another
