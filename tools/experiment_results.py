@@ -15,6 +15,7 @@ import sys
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from palcas_arms import title  # noqa: E402
 from palcas_stats import format_ci, mean_ci95  # noqa: E402
+import repo_paths  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 PAPER_RESULTS = ROOT / "config" / "paper_results.csv"
@@ -317,7 +318,7 @@ def draw_figures(out, settings, points):
             link.unlink()
         if (src / "trajectories.csv").exists():
             link.symlink_to(src)
-    policies = {a: p for a, p in settings.get("policies", {}).items()}
+    policies = {a: repo_paths.usable(p) for a, p in settings.get("policies", {}).items()}
     pngs = run_figures.figures_for_run(gather, out / "figures", policies=policies)
     at = "" if demand is None else f", demand {demand:g} veh/h/lane"
     (out / "figures" / "README.md").write_text(

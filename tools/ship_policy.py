@@ -27,6 +27,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import policy_folder as pf  # noqa: E402
+import repo_paths  # noqa: E402
 
 
 def bridge_line(trained_with, runs_with, as_trained):
@@ -59,7 +60,12 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = pf.train_record(src)
-    bridge = train.get("bridge_params", "")
+    # The record's files, usable here (a relative one is relative to the repository); the
+    # shipped record keeps them repository-relative (tools/repo_paths.py).
+    for key in ("rsu_params", "bridge_params", "v2x_params"):
+        if train.get(key):
+            train[key] = repo_paths.recorded(repo_paths.usable(train[key]))
+    bridge = repo_paths.usable(train.get("bridge_params", ""))
     if bridge_as_trained and not bridge:
         sys.exit(f"--bridge-as-trained: {src} was trained under config/bridge.yaml alone "
                  "(no --bridge-params); nothing to carry")
@@ -97,7 +103,7 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
     for f in pf.RECORD_FILES:
         if (src / f).exists():
             shutil.copy2(src / f, dst / f)
-    learning = train.get("learning", "")
+    learning = repo_paths.usable(train.get("learning", ""))
     if learning:  # the override travels with the policy, referred to by its file name
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name

@@ -186,14 +186,14 @@ result rsu_refuses_eval_without_weights "$why"
 
 # Training through the V2X channel, two episodes in one launch: the RSUs' view of the road
 # starts afresh with the second episode (its steps start again at 0) and both advise;
-# train.json records the channel file.
+# train.json records the channel file (repository-relative: tools/repo_paths.py).
 status=0
 PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 2 --duration 60 \
   --learning "$ROOT/config/training/tiny_fast_learning.yaml" --v2x "$ROOT/test/launch/v2x_impaired.yaml" \
   --out "$WORK/train_v2x" >"$WORK/train_v2x.log" 2>&1 || status=$?
 why=""
 if [ "$status" -ne 0 ]; then why="exit $status: $(tail -3 "$WORK/train_v2x.log")"
-elif ! grep -q '"v2x_params": ".*/test/launch/v2x_impaired.yaml"' "$WORK/train_v2x/train.json"; then
+elif ! grep -q '"v2x_params": "test/launch/v2x_impaired.yaml"' "$WORK/train_v2x/train.json"; then
   why="train.json does not record the channel: $(cat "$WORK/train_v2x/train.json")"
 else
   for e in 0 1; do

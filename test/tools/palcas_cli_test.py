@@ -386,7 +386,10 @@ class LaunchRunner(unittest.TestCase):
         self.assertEqual(experiment.run_point(self.out, "keep_pr60_s1001"), 0)
         record = json.loads((self.out / "points" / "keep_pr60_s1001" / "point.json").read_text())
         self.assertEqual(record["status"], "done")
-        self.assertTrue(record["command"].startswith("%s run --arm keep --no-compare --pr 60 --seed 1001" % (ROOT / "palcas")))
+        # From the repository's folder: its paths are repository-relative (point.json names no
+        # folder of this machine), the point's own folder outside it stays absolute.
+        self.assertTrue(record["command"].startswith("./palcas run --arm keep --no-compare --pr 60 --seed 1001"))
+        self.assertIn("--out %s/points/keep_pr60_s1001" % self.out, record["command"])
         # roslaunch's parent is this process: no ./palcas (bash) in between.
         self.assertIn("palcas_cli_test.py", (self.notes / "parent").read_text())
         self.assertIn("[palcas] results:", (self.out / "points" / "keep_pr60_s1001" / "point.log").read_text())

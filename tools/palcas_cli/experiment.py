@@ -39,6 +39,7 @@ from palcas_cli import Console, ROOT, launch, options, run
 from palcas_cli.options import OptionError
 import experiment_results
 import policy_folder
+import repo_paths
 import seed_sets
 from palcas_arms import ALL_ARMS, LEARNING_ARMS
 
@@ -129,7 +130,7 @@ def settings_from_args(a):
         if seen:
             raise UsageError(f"arm '{arm}': evaluation seed(s) {sorted(seen)} were training "
                              f"seeds of {policy}")
-        policies[arm] = policy
+        policies[arm] = repo_paths.recorded(policy)  # experiment.json: repository-relative
     settings = {"arms": arms, "prs": prs, "seeds": seeds, "seed_set": seed_set, "duration_s": float(a.duration),
                 "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
     if demands is not None:
@@ -138,8 +139,19 @@ def settings_from_args(a):
         path = getattr(a, key, "") or ""
         if path and not os.path.isfile(path):
             raise UsageError(f"{option} {path}: no such file")
-        settings[key] = os.path.abspath(path) if path else ""
+        settings[key] = repo_paths.recorded(path) if path else ""
     return settings
+
+
+def portable(settings):
+    """Settings with their paths as experiment.json keeps them (repository-relative where they
+    lie in the repository): a folder written before that compares equal to a new call."""
+    s = dict(settings, policies={a: repo_paths.recorded(repo_paths.usable(p))
+                                 for a, p in settings.get("policies", {}).items()})
+    for key, _ in POINT_FILES:
+        if s.get(key):
+            s[key] = repo_paths.recorded(repo_paths.usable(s[key]))
+    return s
 
 
 def merge_settings(out, wanted):
@@ -151,6 +163,7 @@ def merge_settings(out, wanted):
     have = json.loads(f.read_text())
     for key, _ in POINT_FILES:  # an experiment from before these options ran without them
         have.setdefault(key, "")
+    have = portable(have)
     have_set = have.get("seed_set") or seed_sets.set_of(have["seeds"])  # a folder from before seed sets
     if have_set != wanted["seed_set"]:
         said = f"seed set '{have_set}' (seeds {seed_sets.describe(have['seeds'])})" if have_set else \
@@ -258,12 +271,12 @@ def run_point(out, name):
     if p["demand"] is not None:
         argv += ["--demand", f"{p['demand']:g}"]
     if p["arm"] in settings["policies"]:
-        argv += ["--policy", settings["policies"][p["arm"]]]
+        argv += ["--policy", repo_paths.usable(settings["policies"][p["arm"]])]
     if not p["trajectories"]:
         argv += ["--no-trajectories"]
     for key, option in POINT_FILES:
         if settings.get(key):
-            argv += [option, settings[key]]
+            argv += [option, repo_paths.usable(settings[key])]
     start = time.time()
     with open(d / "point.log", "w") as log:
         point_console = Console(out=log, err=log)
@@ -279,7 +292,10 @@ def run_point(out, name):
     ok = code == 0 and metrics_complete(out, p, settings["duration_s"])
     record = {"name": name, "arm": p["arm"], "pr": p["pr"], "seed": p["seed"], "demand": p["demand"],
               "status": "done" if ok else "failed", "exit_code": code, "wall_s": round(wall, 1),
-              "command": shlex.join([str(ROOT / "palcas"), "run"] + argv), "host": os.uname().nodename}
+              # From the repository's folder; its paths repository-relative where they lie in it.
+              "command": shlex.join(["./palcas", "run"] + [repo_paths.recorded(a) if os.path.isabs(a) else a
+                                                           for a in argv]),
+              "host": os.uname().nodename}
     if not ok:
         record["error"] = last_error(d / "point.log", d / p["arm"] / "console.log")
     tmp = d / "point.json.tmp"

@@ -31,6 +31,7 @@ from palcas_cli import Console, launch, options
 from palcas_cli.options import OptionError
 import palcas_arms
 import policy_folder
+import repo_paths
 
 # What an option means when a new training leaves it out.
 DEFAULTS = {"arm": "palcas", "episodes": 5, "duration": 3600.0, "pr": 60.0, "seed": 1,
@@ -188,7 +189,7 @@ def settle_options(given, out, resume):
                           "leave --explore-fraction out" % out)
     opts["explore_fraction"] = record["explore_fraction"]
     for key in ("learning", "rsu_params", "bridge_params", "v2x_params"):
-        opts[key] = record.get(key, "")
+        opts[key] = repo_paths.usable(record.get(key, ""))  # recorded relative to the repository
     opts["paper_printed"] = bool(record.get("paper_printed", False))
     return opts, record
 
@@ -202,7 +203,8 @@ def write_record(out, opts, git_commit, command_line="", resume=False):
     """train.json, written whole (a path with a quote or a backslash stays valid JSON). It
     keeps the command that started the training (`command_line`) and lists every later
     `--resume` in `resumed_with`, so a shipped policy names how it was trained, not only how
-    it was last continued."""
+    it was last continued. Its file paths are repository-relative where they lie in the
+    repository (tools/repo_paths.py): a committed record names no folder of this machine."""
     earlier = {}
     if resume:
         try:
@@ -211,9 +213,11 @@ def write_record(out, opts, git_commit, command_line="", resume=False):
         except (OSError, ValueError):
             earlier = {}
     record = {"arm": opts["arm"], "scenario": opts["scenario"], "pr": as_number(opts["pr"]), "seed": opts["seed"],
-              "episodes": opts["episodes"], "duration_s": as_number(opts["duration"]), "learning": opts.get("learning") or "",
-              "rsu_params": opts.get("rsu_params") or "", "bridge_params": opts.get("bridge_params") or "",
-              "v2x_params": opts.get("v2x_params") or "",
+              "episodes": opts["episodes"], "duration_s": as_number(opts["duration"]),
+              "learning": repo_paths.recorded(opts.get("learning")) or "",
+              "rsu_params": repo_paths.recorded(opts.get("rsu_params")) or "",
+              "bridge_params": repo_paths.recorded(opts.get("bridge_params")) or "",
+              "v2x_params": repo_paths.recorded(opts.get("v2x_params")) or "",
               "paper_printed": bool(opts.get("paper_printed")), "explore_fraction": opts["explore_fraction"],
               "demand_vphpl": as_number(opts["demand"]) if opts.get("demand") is not None else None,
               "ramp_demand_vph": as_number(opts["ramp_demand"]) if opts.get("ramp_demand") is not None else None,
