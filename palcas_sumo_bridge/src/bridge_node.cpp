@@ -19,18 +19,6 @@
 namespace palcas::bridge {
 namespace {
 
-MeasureRules measureRules(const BridgeOptions& o, const sim::RoadLayout& road) {
-  MeasureRules rules;
-  for (const sim::ClusterInfo& c : road.clusters())
-    rules.tracker.exit_x_m.push_back(c.off_ramp_edge.empty() ? road.mainlineLengthM() : c.exit_x_m);
-  rules.tracker.miss_margin_m = o.exit_miss_margin_m;
-  rules.tracker.stop_speed_mps = o.merge_stop_speed_mps;
-  rules.tracker.stop_window_m = o.merge_stop_window_m;
-  rules.metrics.comfort_accel_mps2 = o.comfort_threshold_mps2;
-  rules.metrics.steady_state_from_s = o.steady_state_from_s;
-  return rules;
-}
-
 sim::RunnerOptions runnerOptions(const BridgeOptions& o) {
   sim::RunnerOptions r;
   r.duration_s = o.scenario.duration_s;

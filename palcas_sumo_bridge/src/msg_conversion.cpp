@@ -30,7 +30,8 @@ palcas_msgs::VehicleState toMsg(const sim::VehicleRecord& r) {
   return s;
 }
 
-metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& s) {
+metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& s,
+                                          const std::map<std::string, int>& off_ramp_edges) {
   metrics::VehicleObservation o;
   o.id = s.id;
   o.is_cav = s.is_cav;
@@ -38,18 +39,22 @@ metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& s) {
   o.exit_cluster = s.exit_cluster;
   o.x_m = s.x_m;
   o.speed_mps = s.speed_mps;
+  const auto off_ramp = off_ramp_edges.find(s.edge);
   if (s.on_accel_lane) {
     o.road_part = metrics::RoadPart::kAccelLane;
     o.part_cluster = s.entry_cluster;
     o.accel_lane_pos_m = s.accel_lane_pos_m;
     o.accel_lane_length_m = s.accel_lane_length_m;
+  } else if (off_ramp != off_ramp_edges.end()) {
+    // An off-ramp of the road, or a junction lane onto one (where the state still shows the
+    // mainline lane the vehicle came from): which one is the road's, not the edge's name.
+    o.road_part = metrics::RoadPart::kOffRamp;
+    o.part_cluster = off_ramp->second;
   } else if (s.lane >= 1) {
     o.road_part = metrics::RoadPart::kMainline;
-  } else if (s.edge.compare(0, 4, "off_") == 0) {
-    o.road_part = metrics::RoadPart::kOffRamp;
-    o.part_cluster = std::stoi(s.edge.substr(4));
   } else if (s.exit_cluster >= 0 && !std::isfinite(s.distance_to_exit_m)) {
-    // Off the mainline past its exit (any edge names: an own road): on its off-ramp.
+    // Off the mainline past its exit on an edge the road does not place (an own road's
+    // off-ramp of several edges: those after the first): on its off-ramp.
     o.road_part = metrics::RoadPart::kOffRamp;
     o.part_cluster = s.exit_cluster;
   } else {

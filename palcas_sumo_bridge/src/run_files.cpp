@@ -188,7 +188,8 @@ void completeManifest(const BridgeOptions& o, const std::string& sumo_version,
                                {"stop_speed_mps", rules.tracker.stop_speed_mps},
                                {"stop_window_m", rules.tracker.stop_window_m},
                                {"comfort_accel_mps2", rules.metrics.comfort_accel_mps2},
-                               {"steady_state_from_s", rules.metrics.steady_state_from_s}};
+                               {"steady_state_from_s", rules.metrics.steady_state_from_s},
+                               {"off_ramp_edges", rules.off_ramp_edges}};
   writeAtomically(path, manifest);
 }
 
@@ -213,6 +214,14 @@ MeasureRules readMeasureRules(const std::string& manifest_path) {
     rules.metrics.comfort_accel_mps2 = r.at("comfort_accel_mps2").get<double>();
     // Manifests from before the steady-state window: its default.
     rules.metrics.steady_state_from_s = r.value("steady_state_from_s", rules.metrics.steady_state_from_s);
+    if (r.contains("off_ramp_edges")) {
+      rules.off_ramp_edges = r.at("off_ramp_edges").get<std::map<std::string, int>>();
+    } else {
+      // Manifests from before the off-ramps were listed: the edges were judged by the
+      // generated roads' names, off_<k> for cluster k.
+      for (std::size_t k = 0; k < rules.tracker.exit_x_m.size(); ++k)
+        rules.off_ramp_edges["off_" + std::to_string(k)] = static_cast<int>(k);
+    }
   } catch (const json::exception& e) {
     throw std::runtime_error("'" + manifest_path + "': measure_rules incomplete: " + e.what());
   }

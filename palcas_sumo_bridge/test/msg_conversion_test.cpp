@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
+#include <string>
 
 using palcas::bridge::fromMsg;
 using palcas::sim::knownVehicle;
@@ -15,6 +17,9 @@ using palcas::bridge::toObservation;
 namespace metrics = palcas::metrics;
 
 namespace {
+/// The off-ramps of a generated road of three clusters: off_<k> is cluster k's.
+const std::map<std::string, int> kGeneratedOffRamps{{"off_0", 0}, {"off_1", 1}, {"off_2", 2}};
+
 palcas::sim::VehicleRecord rampCav() {
   palcas::sim::VehicleRecord r;
   r.id = "f_on1_off2.7";
@@ -71,41 +76,74 @@ TEST(MsgConversion, VehicleRecordToStateKeepsEveryField) {
 
 TEST(MsgConversion, ObservationFollowsTheRoadPart) {
   auto s = toMsg(rampCav());
-  auto o = toObservation(s);
+  auto o = toObservation(s, kGeneratedOffRamps);
   EXPECT_EQ(o.road_part, metrics::RoadPart::kAccelLane);
   EXPECT_EQ(o.part_cluster, 1);
   EXPECT_EQ(o.route_kind, metrics::RouteKind::kRampExit);
   EXPECT_DOUBLE_EQ(o.accel_lane_pos_m, 62.5);
   s.on_accel_lane = false;
   s.lane = 3;
-  EXPECT_EQ(toObservation(s).road_part, metrics::RoadPart::kMainline);
+  EXPECT_EQ(toObservation(s, kGeneratedOffRamps).road_part, metrics::RoadPart::kMainline);
   s.lane = 0;
   s.edge = "off_2";
-  o = toObservation(s);
+  o = toObservation(s, kGeneratedOffRamps);
   EXPECT_EQ(o.road_part, metrics::RoadPart::kOffRamp);
   EXPECT_EQ(o.part_cluster, 2);
   s.edge = "on_1";
-  EXPECT_EQ(toObservation(s).road_part, metrics::RoadPart::kOnRamp);
+  EXPECT_EQ(toObservation(s, kGeneratedOffRamps).road_part, metrics::RoadPart::kOnRamp);
   s.distance_to_exit_m = std::numeric_limits<double>::infinity();
-  EXPECT_NO_THROW(toObservation(s));
+  EXPECT_NO_THROW(toObservation(s, kGeneratedOffRamps));
   s.route_kind = 9;
-  EXPECT_THROW(toObservation(s), std::invalid_argument);
+  EXPECT_THROW(toObservation(s, kGeneratedOffRamps), std::invalid_argument);
 }
 
 TEST(MsgConversion, OffRampOfAnOwnRoadIsKnownWithoutItsName) {
-  // A user's road names its ramps as it likes: off the mainline, past its exit = on its off-ramp.
+  // A user's road names its ramps as it likes: off the mainline, past its exit, on an edge the
+  // road does not place (an off-ramp's edges after its first) = on its off-ramp.
   auto s = toMsg(rampCav());
   s.on_accel_lane = false;
   s.lane = 0;
   s.exit_cluster = 1;
   s.edge = "slip_out";
   s.distance_to_exit_m = std::numeric_limits<double>::infinity();
-  auto o = toObservation(s);
+  auto o = toObservation(s, kGeneratedOffRamps);
   EXPECT_EQ(o.road_part, metrics::RoadPart::kOffRamp);
   EXPECT_EQ(o.part_cluster, 1);
   s.edge = "slip_in";  // before its exit: still on its on-ramp
   s.distance_to_exit_m = 300.0;
-  EXPECT_EQ(toObservation(s).road_part, metrics::RoadPart::kOnRamp);
+  EXPECT_EQ(toObservation(s, kGeneratedOffRamps).road_part, metrics::RoadPart::kOnRamp);
+}
+
+TEST(MsgConversion, AnOffRampIsTheRoadsNotItsNames) {
+  // A user's road (config/scenarios/three_ramps) numbers its exits from 1: off_1 leaves in
+  // zone 0, off_2 in zone 1, off_3 in zone 3. The road says whose each is, not the name.
+  const std::map<std::string, int> own{{"off_1", 0}, {"off_2", 1}, {"off_3", 3},
+                                       {":harbour_exit_0", 0}, {":park_exit_0", 3}};
+  auto s = toMsg(rampCav());
+  s.on_accel_lane = false;
+  s.lane = 0;
+  s.exit_cluster = 0;
+  s.edge = "off_1";
+  s.distance_to_exit_m = std::numeric_limits<double>::infinity();
+  auto o = toObservation(s, own);
+  EXPECT_EQ(o.road_part, metrics::RoadPart::kOffRamp);
+  EXPECT_EQ(o.part_cluster, 0);
+  s.edge = "off_3";
+  EXPECT_EQ(toObservation(s, own).part_cluster, 3);
+  // On the junction lane onto its off-ramp the state still shows lane 1 (the session keeps a
+  // vehicle's last lane there): it has left the mainline all the same.
+  s.edge = ":harbour_exit_0";
+  s.lane = 1;
+  o = toObservation(s, own);
+  EXPECT_EQ(o.road_part, metrics::RoadPart::kOffRamp);
+  EXPECT_EQ(o.part_cluster, 0);
+  s.edge = ":harbour_exit_1";  // the junction lanes straight on: still the mainline
+  EXPECT_EQ(toObservation(s, own).road_part, metrics::RoadPart::kMainline);
+  // Without the road's list an edge called off_<k> is no off-ramp of its own.
+  s.edge = "off_3";
+  s.lane = 0;
+  s.distance_to_exit_m = 40.0;
+  EXPECT_EQ(toObservation(s, {}).road_part, metrics::RoadPart::kOnRamp);
 }
 
 TEST(MsgConversion, VehicleEventRoundTrip) {

@@ -7,14 +7,27 @@
 #include <palcas_msgs/VehicleEventArray.h>
 #include <palcas_msgs/VehicleStateArray.h>
 
+#include <map>
+#include <string>
 #include <vector>
+
+#include "palcas_sim/road_layout.h"
+#include "palcas_sumo_bridge/bridge_options.h"
 
 namespace palcas::bridge {
 
 struct MeasureRules {
   metrics::OutcomeTrackerOptions tracker;
   metrics::EpisodeMetricsOptions metrics;
+  /// Edges on which a vehicle is on an off-ramp -> that off-ramp's cluster
+  /// (RoadLayout::offRampEdges of the road the bridge built): an exit is judged on the
+  /// vehicle's own off-ramp, found by edge, never by its name.
+  std::map<std::string, int> off_ramp_edges;
 };
+
+/// The rules of the bridge's road: one exit x per cluster (the mainline's end for a cluster
+/// without an off-ramp), the off-ramps' edges, the margins and thresholds of `options`.
+MeasureRules measureRules(const BridgeOptions& options, const sim::RoadLayout& road);
 
 class EpisodeMeasure {
  public:
@@ -33,6 +46,7 @@ class EpisodeMeasure {
  private:
   metrics::OutcomeTracker tracker_;
   metrics::EpisodeMetricsAccumulator metrics_;
+  std::map<std::string, int> off_ramp_edges_;
 };
 
 /// The removal lists of a step, recovered from its published events (COLLISION, TELEPORT,

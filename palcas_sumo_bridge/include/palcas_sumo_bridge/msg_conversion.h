@@ -11,6 +11,9 @@
 #include <palcas_msgs/VehicleEvent.h>
 #include <palcas_msgs/VehicleState.h>
 
+#include <map>
+#include <string>
+
 #include "palcas_sim/sumo_session.h"
 
 namespace palcas::bridge {
@@ -18,8 +21,11 @@ namespace palcas::bridge {
 palcas_msgs::VehicleState toMsg(const sim::VehicleRecord& record);
 
 /// What the outcome tracker needs, derived from the published state only, so that a
-/// recorded bag reproduces the live decisions exactly.
-metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& state);
+/// recorded bag reproduces the live decisions exactly. `off_ramp_edges` (MeasureRules) says
+/// which edges are an off-ramp and whose: a vehicle on one is on that off-ramp (junction
+/// lanes onto it included, whatever lane the state still shows there).
+metrics::VehicleObservation toObservation(const palcas_msgs::VehicleState& state,
+                                          const std::map<std::string, int>& off_ramp_edges);
 
 palcas_msgs::VehicleEvent toMsg(const metrics::VehicleEvent& event);
 /// @throws std::invalid_argument for an event or route kind code outside its enum.

@@ -315,6 +315,23 @@ OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options) {
     }
     road.edges.push_back(r);
   }
+  // Junction lanes from the mainline onto each off-ramp: the internal edges on those links'
+  // way, less any that a link to somewhere else also drives through.
+  std::map<std::string, std::set<std::string>> onto;  // internal edge -> off-ramps it leads onto
+  std::set<std::string> shared;                        // on the way of a link to anywhere else
+  for (const std::string& id : road.mainline)
+    for (const NetLink* l : g.links(id, "")) {
+      const bool to_off_ramp = !on_main.count(l->to_edge) &&
+                               std::any_of(road.edges.begin(), road.edges.end(), [&](const EdgeInfo& e) {
+                                 return e.id == l->to_edge && e.part == RoadPart::kOffRamp;
+                               });
+      g.viaLength(l->via, [&](const std::string& internal, double) {
+        if (to_off_ramp) onto[internal].insert(l->to_edge);
+        else shared.insert(internal);
+      });
+    }
+  for (const auto& [internal, ramps] : onto)
+    if (ramps.size() == 1 && !shared.count(internal)) road.onto_off_ramp[internal] = *ramps.begin();
   for (const std::string& id : road.mainline) {
     EdgeInfo& m = info[id];
     if (m.has_accel_lane && m.cluster < 0)

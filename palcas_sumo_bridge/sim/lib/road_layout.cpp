@@ -64,7 +64,7 @@ RoadLayout::RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double c
 
 RoadLayout::RoadLayout(const OwnRoad& road)
     : edges_(road.edges), mainline_(road.mainline), internal_x_start_m_(road.internal_x_start_m),
-      measured_along_lanes_(true), num_main_lanes_(road.num_main_lanes),
+      onto_off_ramp_(road.onto_off_ramp), measured_along_lanes_(true), num_main_lanes_(road.num_main_lanes),
       cluster_length_m_(road.cluster_length_m), mainline_length_m_(road.mainline_length_m) {
   if (mainline_.empty() || !(cluster_length_m_ > 0.0) || num_main_lanes_ < 1)
     throw std::invalid_argument("RoadLayout: the road has no mainline");
@@ -129,6 +129,17 @@ double RoadLayout::xAlongMainline(const std::string& edge_id, double lane_pos_m,
   return internal == internal_x_start_m_.end() ? otherwise : internal->second + lane_pos_m;
 }
 
+std::map<std::string, int> RoadLayout::offRampEdges() const {
+  std::map<std::string, int> out;
+  for (const ClusterInfo& c : clusters_)
+    if (!c.off_ramp_edge.empty()) out[c.off_ramp_edge] = c.index;
+  for (const auto& [internal, ramp] : onto_off_ramp_) {
+    auto it = out.find(ramp);
+    if (it != out.end()) out[internal] = it->second;
+  }
+  return out;
+}
+
 const EdgeInfo& RoadLayout::edge(const std::string& id) const {
   auto it = index_.find(id);
   if (it == index_.end()) throw std::out_of_range("RoadLayout: unknown edge '" + id + "'");
@@ -153,6 +164,21 @@ int RoadLayout::sumoLaneIndex(const std::string& edge_id, int paper_lane) const 
   if (e.part != RoadPart::kMainline || paper_lane < 1 || paper_lane > num_main_lanes_) return -1;
   const int index = e.has_accel_lane ? paper_lane : paper_lane - 1;
   return index < e.lane_count ? index : -1;
+}
+
+void classifyRouteByEdges(const RoadLayout& road, const std::vector<std::string>& edges, RouteKind* kind,
+                          int* entry_cluster, int* exit_cluster) {
+  int entry = -1, exit = -1;
+  for (const std::string& id : edges) {
+    if (!road.hasEdge(id)) continue;
+    const EdgeInfo& e = road.edge(id);
+    if (e.part == RoadPart::kOnRamp && entry < 0) entry = e.cluster;
+    if (e.part == RoadPart::kOffRamp && exit < 0) exit = e.cluster;
+  }
+  *entry_cluster = entry;
+  *exit_cluster = exit;
+  if (entry < 0) *kind = exit < 0 ? RouteKind::kMainThrough : RouteKind::kMainExit;
+  else *kind = exit < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
 }
 
 }  // namespace palcas::sim

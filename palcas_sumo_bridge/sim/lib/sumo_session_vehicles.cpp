@@ -31,18 +31,6 @@ void parseRouteId(const std::string& route_id, RouteKind* kind, int* entry_clust
   else *kind = exit < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
 }
 
-void SumoSession::classifyRouteByEdges(const std::vector<std::string>& edges, VehicleRecord* v) const {
-  v->entry_cluster = v->exit_cluster = -1;
-  for (const std::string& id : edges) {
-    if (!road_->hasEdge(id)) continue;
-    const EdgeInfo& e = road_->edge(id);
-    if (e.part == RoadPart::kOnRamp && v->entry_cluster < 0) v->entry_cluster = e.cluster;
-    if (e.part == RoadPart::kOffRamp && v->exit_cluster < 0) v->exit_cluster = e.cluster;
-  }
-  if (v->entry_cluster < 0) v->route_kind = v->exit_cluster < 0 ? RouteKind::kMainThrough : RouteKind::kMainExit;
-  else v->route_kind = v->exit_cluster < 0 ? RouteKind::kRampThrough : RouteKind::kRampExit;
-}
-
 void SumoSession::removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed) {
   auto it = index_.find(id);
   if (it == index_.end()) return;
@@ -62,12 +50,16 @@ void SumoSession::onDeparted(const std::string& id) {
   v.type_id = api::Vehicle::getTypeID(id);
   v.route_id = api::Vehicle::getRouteID(id);
   v.is_cav = v.type_id.compare(0, 3, "cav") == 0;
-  try {
-    parseRouteId(v.route_id, &v.route_kind, &v.entry_cluster, &v.exit_cluster);
-  } catch (const std::invalid_argument&) {
-    v.route_kind = RouteKind::kMainThrough;  // foreign routes: tracked, never controlled
-    // On an own road (a user's route file) the route's ramps say where it enters and leaves.
-    if (road_->measuredAlongLanes()) classifyRouteByEdges(api::Vehicle::getRoute(id), &v);
+  if (road_->measuredAlongLanes()) {
+    // On an own road the route's own ramps say where it enters and leaves, whatever its id
+    // (a user's route file may use ids of the r_<from>_<to> form numbered its own way).
+    classifyRouteByEdges(*road_, api::Vehicle::getRoute(id), &v.route_kind, &v.entry_cluster, &v.exit_cluster);
+  } else {
+    try {
+      parseRouteId(v.route_id, &v.route_kind, &v.entry_cluster, &v.exit_cluster);
+    } catch (const std::invalid_argument&) {
+      v.route_kind = RouteKind::kMainThrough;  // foreign routes: tracked, never controlled
+    }
   }
   v.length_m = api::Vehicle::getLength(id);
   v.width_m = api::Vehicle::getWidth(id);

@@ -228,6 +228,65 @@ TEST(OwnRoad, ANetXmlIsUsedAsItIs) {
   EXPECT_DOUBLE_EQ(road.mainline_length_m, curvedRoad().mainline_length_m);
 }
 
+ScenarioConfig threeRampsConfig() {
+  ScenarioConfig c;
+  c.scenario_dir = scenarioDir("three_ramps");
+  c.network_file = "ring.netccfg";
+  c.road.clusters = 4;
+  c.road.num_lanes = 5;
+  c.duration_s = 120.0;
+  return c;
+}
+
+TEST(OwnRoad, ThreeRampsEachInTheZoneOfItsJunction) {
+  // config/scenarios/three_ramps: exits numbered off_1..off_3 by their user, in zones 0, 1
+  // and 3 of four (750 m each); entries in zones 0, 1 and 2.
+  const ScenarioFiles files = writeScenario(threeRampsConfig(), freshDir("own_road_three_ramps"));
+  const RoadLayout road(discoverOwnRoad(readNetTopology(files.net_file), ownRoadOptions(threeRampsConfig())));
+  ASSERT_EQ(road.clusters().size(), 4u);
+  EXPECT_NEAR(road.mainlineLengthM(), 3000.0, 1.0);
+  std::vector<std::string> on, off;
+  for (const ClusterInfo& c : road.clusters()) {
+    on.push_back(c.on_ramp_edge);
+    off.push_back(c.off_ramp_edge);
+  }
+  EXPECT_EQ(on, (std::vector<std::string>{"entry_harbour", "entry_mall", "entry_park", ""}));
+  EXPECT_EQ(off, (std::vector<std::string>{"off_1", "off_2", "", "off_3"}));
+  // Near the zone boundaries: off_1 leaves 24 m before the first, off_3 56 m after the third.
+  EXPECT_NEAR(road.clusters()[0].exit_x_m, 726.0, 1.0);
+  EXPECT_NEAR(road.clusters()[3].exit_x_m, 2306.0, 1.0);
+
+  // The junction lanes onto each off-ramp are that off-ramp's (off_1's and off_3's leave at a
+  // shallow angle: 26 m, longer than the 20 m miss margin); those straight on are not.
+  const std::map<std::string, int> off_ramps = road.offRampEdges();
+  EXPECT_EQ(off_ramps.at("off_1"), 0);
+  EXPECT_EQ(off_ramps.at("off_2"), 1);
+  EXPECT_EQ(off_ramps.at("off_3"), 3);
+  EXPECT_EQ(off_ramps.at(":harbour_exit_0"), 0);
+  EXPECT_EQ(off_ramps.at(":mall_exit_0"), 1);
+  EXPECT_EQ(off_ramps.at(":park_exit_0"), 3);
+  EXPECT_EQ(off_ramps.count(":harbour_exit_1"), 0u);
+  EXPECT_EQ(off_ramps.size(), 6u);
+  EXPECT_EQ(off_ramps.count("mall_street"), 0u);  // the mall exit's second edge: not placed
+
+  // A route's entry and exit are its ramps', whatever its id says.
+  RouteKind kind = RouteKind::kMainThrough;
+  int entry = -9, exit = -9;
+  classifyRouteByEdges(road, {"mall_street_in", "entry_mall", "A1_mall_weave", "A1_mall", "A1_mall_park",
+                              "A1_park_weave", "A1_park", "off_3"},
+                       &kind, &entry, &exit);
+  EXPECT_EQ(kind, RouteKind::kRampExit);
+  EXPECT_EQ(entry, 1);
+  EXPECT_EQ(exit, 3);
+  classifyRouteByEdges(road, {"A1_west", "A1_harbour_weave", "A1_harbour", "off_1"}, &kind, &entry, &exit);
+  EXPECT_EQ(kind, RouteKind::kMainExit);
+  EXPECT_EQ(entry, -1);
+  EXPECT_EQ(exit, 0);
+  classifyRouteByEdges(road, {"A1_park", "A1_east"}, &kind, &entry, &exit);
+  EXPECT_EQ(kind, RouteKind::kMainThrough);
+  EXPECT_EQ(exit, -1);
+}
+
 // Hand-made topologies for the rule's corner cases (no netconvert needed).
 NetTopology straightRoad(const std::vector<std::tuple<std::string, std::string, std::string, int>>& edges,
                          const std::vector<std::pair<std::string, std::string>>& links) {
@@ -252,6 +311,26 @@ TEST(OwnRoad, TwoOffRampsInOneZoneAreRefusedNamingBoth) {
   EXPECT_EQ(road.mainline, (std::vector<std::string>{"a", "b", "c"}));
   EXPECT_EQ(road.exit_from_edge.at(0), "a");
   EXPECT_EQ(road.exit_from_edge.at(1), "b");
+}
+
+TEST(OwnRoad, JunctionLanesOntoAnOffRampAreItsOwn) {
+  NetTopology net = straightRoad({{"a", "n0", "n1", 3}, {"b", "n1", "n2", 3}, {"x", "n1", "r", 1}},
+                                 {{"a", "b"}, {"a", "x"}});
+  net.links[0].via = ":n1_1_0";   // a -> b, straight on
+  net.links[1].via = ":n1_0_0";   // a -> x, onto the off-ramp, then a second internal lane
+  net.links.push_back({":n1_0", 0, "x", 0, ":n1_2_0"});
+  net.lane_length_m[":n1_1_0"] = 5.0;
+  net.lane_length_m[":n1_0_0"] = 30.0;
+  net.lane_length_m[":n1_2_0"] = 6.0;
+  OwnRoadOptions o;
+  o.clusters = 2;
+  const OwnRoad road = discoverOwnRoad(net, o);
+  EXPECT_EQ(road.onto_off_ramp, (std::map<std::string, std::string>{{":n1_0", "x"}, {":n1_2", "x"}}));
+  const RoadLayout layout(road);
+  EXPECT_EQ(layout.offRampEdges(), (std::map<std::string, int>{{"x", 0}, {":n1_0", 0}, {":n1_2", 0}}));
+  // An internal edge the way to the ramp shares with the way straight on is not the ramp's.
+  net.links[0].via = ":n1_2_0";
+  EXPECT_EQ(discoverOwnRoad(net, o).onto_off_ramp, (std::map<std::string, std::string>{{":n1_0", "x"}}));
 }
 
 TEST(OwnRoad, AnAmbiguousMainlineAsksForTheEdgeList) {

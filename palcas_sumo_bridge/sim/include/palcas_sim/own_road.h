@@ -18,7 +18,9 @@
 //   lanes      paper lane 1 = the rightmost through lane; L = the most through lanes of any
 //              mainline edge (an edge with fewer has no lanes above its count: a lane drop);
 //   zones      the mainline split into `clusters` equal zones; a ramp belongs to the zone
-//              holding its junction; at most one on-ramp and one off-ramp per zone.
+//              holding its junction; at most one on-ramp and one off-ramp per zone;
+//   junction   the junction-internal edges from the mainline onto an off-ramp belong to that
+//              off-ramp (its exit is judged on them: metrics.md, "OutcomeTracker rules").
 
 #include <map>
 #include <string>
@@ -70,6 +72,11 @@ struct OwnRoad {
   std::map<std::string, double> internal_x_start_m;  ///< junction-internal edge -> x where it starts
   std::map<int, std::string> exit_from_edge;         ///< zone -> mainline edge its off-ramp leaves
   std::map<int, std::string> on_ramp_joins_edge;     ///< zone -> mainline edge its on-ramp joins
+  /// Junction-internal edge -> the off-ramp it leads onto from the mainline (only edges that
+  /// lead nowhere else). A vehicle on one has left the mainline for that off-ramp, however
+  /// long the junction lane is (netconvert makes it 30 m and more where a ramp leaves at a
+  /// shallow angle).
+  std::map<std::string, std::string> onto_off_ramp;
   int num_main_lanes = 0;                  ///< L: most through lanes of a mainline edge
   int clusters = 1;
   double mainline_length_m = 0.0;

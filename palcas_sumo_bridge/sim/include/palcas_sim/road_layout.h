@@ -72,6 +72,11 @@ class RoadLayout {
   /// x of a vehicle at `lane_pos_m` on `edge_id` (a junction-internal edge too), measured
   /// along the lanes; `otherwise` for an edge the road does not place.
   double xAlongMainline(const std::string& edge_id, double lane_pos_m, double otherwise) const;
+  /// Where a vehicle is on an off-ramp, by edge, with the index of the cluster that off-ramp
+  /// belongs to: every cluster's off-ramp edge and, on an own road, the junction-internal
+  /// edges from the mainline onto it. Read off the road, never off an edge's name, so an
+  /// exit is judged on the vehicle's own off-ramp whatever the edges are called.
+  std::map<std::string, int> offRampEdges() const;
 
   /// Paper lane (1 = rightmost mainline lane .. L; 0 = not on a mainline lane) of a SUMO
   /// lane index on an edge. This is the one place where the conventions meet.
@@ -88,11 +93,18 @@ class RoadLayout {
   std::map<std::string, std::size_t> index_;
   std::vector<std::string> mainline_;
   std::map<std::string, double> internal_x_start_m_;
+  std::map<std::string, std::string> onto_off_ramp_;  ///< own road: junction edge -> its off-ramp
   bool measured_along_lanes_ = false;
   std::vector<ClusterInfo> clusters_;
   int num_main_lanes_;
   double cluster_length_m_;
   double mainline_length_m_ = 0.0;
 };
+
+/// Route kind and clusters from a route's edges on `road`: the cluster of the first on-ramp
+/// and of the first off-ramp among them (-1: none). How an own road's routes are read,
+/// whatever their ids: a route's exit is the off-ramp it takes.
+void classifyRouteByEdges(const RoadLayout& road, const std::vector<std::string>& edges, RouteKind* kind,
+                          int* entry_cluster, int* exit_cluster);
 
 }  // namespace palcas::sim

@@ -321,9 +321,6 @@ class SumoSession {
   /// readNetwork for a road of own_road_net_file: the layout from discoverOwnRoad, the edges
   /// the session needs from the layout's mainline order.
   void readOwnRoad();
-  /// Entry and exit zone and route kind of a route not named r_<from>_<to> (a user's route
-  /// file), from the first on-ramp and off-ramp among its edges.
-  void classifyRouteByEdges(const std::vector<std::string>& edges, VehicleRecord* v) const;
   void onDeparted(const std::string& id);
   void readVehicles();
   void updateDerived(VehicleRecord& v) const;
