@@ -325,6 +325,17 @@ class LaunchRunner(unittest.TestCase):
         self.assertIn("logging to %s (master http://127.0.0.1:%d)" % (self.out / "ros_log", lx.port), console)
         self.assertIn("\x1b[32m", console)  # the log keeps what roslaunch wrote
 
+    def test_a_master_that_lost_its_port_is_told_from_a_run_that_failed(self):
+        console = self.out / "console.log"
+        console.write_text("an earlier launch's lines: Address already in use, could not contact master\n")
+        lx = launch.Launch(["palcas_launch", "system.launch"], console, self.out / "ros_log", append=True).start()
+        lx.wait()
+        self.assertFalse(lx.lost_its_port())  # only this launch's own lines count
+        with open(console, "a") as f:
+            f.write("OSError: [Errno 98] Address already in use\nRLException: ERROR: could not contact master "
+                    "[http://127.0.0.1:%d/]\n" % lx.port)
+        self.assertTrue(lx.lost_its_port())
+
     def test_sigint_reaches_the_launch_and_the_wait_says_interrupted(self):
         os.environ["FAKE_WAITS"] = "1"
         # As when ./palcas was started with '&' by a non-interactive shell (a CI runner):

@@ -20,6 +20,12 @@ SHOWN = r"palcas bridge: (episode|SUMO)|FATAL|ERROR"
 POLL_S = 0.2  # how often a waiting launch reads its console and looks at its helpers
 
 
+# What roslaunch prints when its master's port was taken before it could bind it.
+MASTER_PORT_TAKEN = "Address already in use"
+# Starts of a launch whose master lost its port to another process, before giving up.
+PORT_ATTEMPTS = 3
+
+
 def free_port():
     s = socket.socket()
     s.bind(("127.0.0.1", 0))
@@ -161,6 +167,7 @@ class Launch:
         self.append, self.show = append, re.compile(show) if show else None
         self.shown = shown or sys.stdout
         self.port, self.process, self._offset, self._partial = None, None, 0, ""
+        self._start_offset = 0
 
     def start(self):
         if interrupted():  # the command was stopped before this launch: none starts
@@ -168,7 +175,7 @@ class Launch:
         self.port = free_port()
         mode = "a" if self.append else "w"
         with open(self.console, mode) as console:
-            self._offset = console.tell()
+            self._offset = self._start_offset = console.tell()
             self.process = subprocess.Popen(
                 # env --default-signal: a command started in the background by a non-interactive
                 # shell (a CI runner, `./palcas test &`) passes SIGINT on ignored, and a launch
@@ -182,6 +189,17 @@ class Launch:
         if interrupted():  # stopped while it started
             self.interrupt()
         return self
+
+    def lost_its_port(self):
+        """True when this launch's master could not bind its port (another process took it
+        between free_port() and roscore's bind): no node ran, so starting again is safe."""
+        try:
+            with open(self.console, errors="replace") as f:
+                f.seek(self._start_offset)
+                text = f.read()
+        except OSError:
+            return False
+        return MASTER_PORT_TAKEN in text and "could not contact master" in text
 
     def wait(self, tick=None):
         """Waits for roslaunch to end, showing its console; tick() runs every POLL_S meanwhile

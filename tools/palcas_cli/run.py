@@ -278,11 +278,17 @@ def launch_arm(args, folder, with_rviz, rviz, console, show):
     has framed the road (each arm is shown on its own master)."""
     rviz.close()
     remove(os.path.join(folder, "palcas.rviz"))  # rviz waits for this run's view, never a stale one
-    arm_launch = launch.Launch(args, os.path.join(folder, "console.log"), os.path.join(folder, "ros_log"),
-                               show=show, shown=console.out).start()
-    if with_rviz:
-        rviz.watch(folder, arm_launch.port)
-    arm_launch.wait(tick=rviz.poll)
+    for attempt in range(launch.PORT_ATTEMPTS):
+        # The free port is chosen before roscore binds it: another launch (an experiment's
+        # other job, a test) may take it between the two; then nothing ran, start again.
+        arm_launch = launch.Launch(args, os.path.join(folder, "console.log"), os.path.join(folder, "ros_log"),
+                                   append=attempt > 0, show=show, shown=console.out).start()
+        if with_rviz:
+            rviz.watch(folder, arm_launch.port)
+        arm_launch.wait(tick=rviz.poll)
+        if not arm_launch.lost_its_port():
+            return
+        console.log("the master's port %d was taken before roslaunch bound it: starting again" % arm_launch.port)
 
 
 def draw_figures(out):
