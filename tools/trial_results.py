@@ -79,12 +79,7 @@ class TrialError(Exception):
 
 # --- reading -------------------------------------------------------------------------------
 
-def number(v):
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return None
-    return f if math.isfinite(f) else None
+from experiment_results import number  # noqa: E402  (a finite float, or None)
 
 
 def shown_path(path):

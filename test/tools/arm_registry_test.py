@@ -142,6 +142,16 @@ def scratch_copy_with_new_arm(new_arm=NEW_ARM, like="independent", after="palcas
     return copy
 
 
+def copy_launch_env(test, copy):
+    """The environment in which roslaunch finds the copy's palcas_config, palcas_launch and
+    palcas_policies (linked) before the workspace's, and the copy's system.launch."""
+    if not shutil.which("roslaunch") or "ROS_PACKAGE_PATH" not in os.environ:
+        test.fail("needs the workspace's ROS environment: source devel/setup.bash first")
+    env = dict(os.environ, ROS_PACKAGE_PATH=f"{copy}:{os.environ['ROS_PACKAGE_PATH']}",
+               PATH="/usr/bin:" + os.environ["PATH"])
+    return env, str(copy / "launch" / "system.launch")
+
+
 def run(cmd, cwd, env=None):
     return subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, timeout=120)
 
@@ -215,12 +225,7 @@ class AddingAnArm(unittest.TestCase):
         self.assertEqual(r.stdout.strip(), "['rsu_0', 'rsu_1', 'rsu_2']", r.stderr)
 
     def test_the_launch_runs_it(self):
-        if not shutil.which("roslaunch") or "ROS_PACKAGE_PATH" not in os.environ:
-            self.fail("needs the workspace's ROS environment: source devel/setup.bash first")
-        # The copy's palcas_config, palcas_launch and palcas_policies (linked) before the workspace's.
-        env = dict(os.environ, ROS_PACKAGE_PATH=f"{self.copy}:{os.environ['ROS_PACKAGE_PATH']}",
-                   PATH="/usr/bin:" + os.environ["PATH"])
-        launch = str(self.copy / "launch" / "system.launch")
+        env, launch = copy_launch_env(self, self.copy)
         r = run(["roslaunch", "--nodes", launch, f"arm:={NEW_ARM}", "out_dir:=/tmp/unused"], cwd=self.copy, env=env)
         self.assertEqual(sorted(r.stdout.split()), ["/fedserver/palcas_fedserver", "/palcas_sumo_bridge",
                                                     "/rsu_0/rsu", "/rsu_1/rsu", "/rsu_2/rsu"], r.stdout + r.stderr)
@@ -272,11 +277,7 @@ class AddingAControlArm(unittest.TestCase):
         self.assertIn(f"{CONTROL_ARM}_pr60_s{seed_sets.seeds('test', 1)[0]}", (out / "plan.txt").read_text())
 
     def test_the_launch_starts_rule_rsus_under_the_learned_arms_actuation(self):
-        if not shutil.which("roslaunch") or "ROS_PACKAGE_PATH" not in os.environ:
-            self.fail("needs the workspace's ROS environment: source devel/setup.bash first")
-        env = dict(os.environ, ROS_PACKAGE_PATH=f"{self.copy}:{os.environ['ROS_PACKAGE_PATH']}",
-                   PATH="/usr/bin:" + os.environ["PATH"])
-        launch = str(self.copy / "launch" / "system.launch")
+        env, launch = copy_launch_env(self, self.copy)
         r = run(["roslaunch", "--nodes", launch, f"arm:={CONTROL_ARM}", "out_dir:=/tmp/unused"], cwd=self.copy, env=env)
         self.assertEqual(sorted(r.stdout.split()), ["/palcas_sumo_bridge", "/rsu_0/rsu", "/rsu_1/rsu", "/rsu_2/rsu"],
                          r.stdout + r.stderr)  # no federation server: a rule learns nothing
