@@ -95,8 +95,10 @@ def input_files(folder, out_dir=None):
     folder = pathlib.Path(folder)
     files = sorted(folder.glob("*.csv")) + sorted(folder.glob("*/results.csv"))
     if out_dir is not None:
-        out = pathlib.Path(out_dir).resolve()
-        files = [f for f in files if out not in f.resolve().parents]
+        # The page's own CSVs (OUT/results/) are outputs, never inputs; the default OUT (docs)
+        # holds the input folder docs/trial itself.
+        made = (pathlib.Path(out_dir) / "results").resolve()
+        files = [f for f in files if made not in f.resolve().parents]
     return files
 
 
