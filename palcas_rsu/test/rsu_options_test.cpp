@@ -119,6 +119,10 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
   expectRefused("nan", [](ros::NodeHandle& nh) { nh.setParam("reward/iota", std::nan("")); }, "reward/iota");
   expectRefused("wait", [](ros::NodeHandle& nh) { nh.setParam("decision_inputs_wait_s", -0.1); },
                 "decision_inputs_wait_s");
+  expectRefused("advice", [](ros::NodeHandle& nh) { nh.setParam("rsu/advice", std::string("magic")); },
+                "'magic', not one of network, rules");
+  expectRefused("rule", [](ros::NodeHandle& nh) { nh.setParam("rules/exit_margin_m", -1.0); },
+                "rules/exit_margin_m");
 }
 
 int main(int argc, char** argv) {
