@@ -10,49 +10,15 @@
 #include <palcas_msgs/RsuStatus.h>
 
 #include <cstdio>
-#include <filesystem>
-#include <limits>
+#include <cmath>
 
+#include "palcas_rsu/federation_transport.h"
 #include "palcas_rsu/msg_conversion.h"
 #include "palcas_rsu/topics.h"
 
 namespace palcas::rsu {
-namespace fs = std::filesystem;
 
 namespace {
-
-/// policy_dir's value for an evaluation of an untrained network, asked for on purpose.
-constexpr const char* RANDOM_POLICY = "random";
-
-/// An evaluation runs trained weights: refused before anything waits for the bridge.
-void requireEvalWeights(const RsuNodeOptions& o) {
-  if (o.controller.train || o.policy_dir == RANDOM_POLICY) return;
-  if (o.controller.advice_source == AdviceSource::kRules) return;  // the rule needs no weights
-  if (o.policy_dir.empty())
-    throw std::runtime_error(
-        "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR (a training's "
-        "checkpoints/ folder; system.launch's default 'shipped' is policies/<arm>/checkpoints; "
-        "./palcas train makes new ones), or policy_dir:=random to evaluate an untrained network on "
-        "purpose. Only mode train starts from random weights");
-  if (!fs::is_directory(o.policy_dir))
-    throw std::runtime_error("policy_dir '" + o.policy_dir + "' is not a folder (eval needs a training's "
-                             "checkpoints/ folder, e.g. policies/palcas/checkpoints)");
-}
-
-/// When the node decides, learns, ticks the federation client and checkpoints.
-RsuScheduleOptions scheduleOf(const RsuNodeOptions& o) {
-  RsuScheduleOptions s;
-  s.decision_period_steps = o.decision_period_steps;
-  s.train = o.controller.train;
-  s.reward_over_period = o.controller.reward_over_period;
-  s.learner_thread = o.learner_thread;
-  s.checkpoint_every_decisions = o.checkpoint_every_decisions;
-  s.checkpoint_dir_set = !o.checkpoint_dir.empty();
-  // In training the federation client exists exactly when federation is on
-  // (loadInitialModel); in eval the schedule never ticks it.
-  s.federation = o.federation;
-  return s;
-}
 
 /// The node's options with what they leave to the bridge's road filled in from it (the
 /// bridge sets it before opening registration; an RSU may start first, so wait for it).
@@ -80,29 +46,17 @@ DecisionInputs decisionInputsOf(const RsuNodeOptions& o) {
 }  // namespace
 
 RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), private_nh_(private_nh), options_(loadOptionsOnTheRoad(nh_, private_nh_)),
-      controller_(std::make_unique<RsuController>(options_.controller)),
+    : nh_(nh), private_nh_(private_nh),
+      decider_(std::make_unique<RsuDecider>(loadOptionsOnTheRoad(nh_, private_nh_))),
+      options_(decider_->options()),
       auth_key_(common::loadMessageKey(options_.auth_key_file)),
-      schedule_(scheduleOf(options_)),
-      peers_(options_.controller.cluster_index, options_.i2i_stale_after_s),
-      learning_log_(options_.checkpoint_dir.empty() ? "" : (fs::path(checkpointDir()) / "learning.csv").string(),
-                    options_.controller.rsu_id, options_.controller.train ? "train" : "eval"),
       inputs_(decisionInputsOf(options_)) {
   const RsuControllerOptions& c = options_.controller;
-  if (options_.resume && !fs::exists(fs::path(checkpointDir()) / "agent.ckpt")) {
-    // A new training, or one that stopped before this RSU wrote anything: start afresh.
-    ROS_INFO_NAMED("checkpoint", "%s: no checkpoint in %s yet; starting afresh", c.rsu_id.c_str(), checkpointDir().c_str());
-  } else if (options_.resume) {
-    controller_->loadCheckpoint(checkpointDir());
-    ROS_INFO_NAMED("checkpoint", "%s: resumed from %s (gradient steps %lu, model version %u)", c.rsu_id.c_str(),
-             checkpointDir().c_str(), static_cast<unsigned long>(controller_->agent().gradientSteps()),
-             controller_->modelVersion());
-  }
   // Federation traffic, latched and once per round: what this RSU sent and what it holds
   // after loading the global model (for tests, bags and debugging).
   submitted_pub_ = nh_.advertise<palcas_msgs::ModelWeights>(SUBMITTED_WEIGHTS_TOPIC, 1, true);
   model_pub_ = nh_.advertise<palcas_msgs::ModelWeights>(MODEL_TOPIC, 1, true);
-  loadInitialModel();
+  if (decider_->wantsFederation()) startFederation();
   advisories_pub_ = nh_.advertise<palcas_msgs::AdvisoryArray>(ADVISORIES_TOPIC, 10);
   cluster_pub_ = nh_.advertise<palcas_msgs::ClusterState>(CLUSTER_STATES_TOPIC, 10);
   status_pub_ = nh_.advertise<palcas_msgs::RsuStatus>(RSU_STATUS_TOPIC, 10);
@@ -125,57 +79,16 @@ RsuNode::RsuNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            options_.decision_period_steps, options_.federation ? "on" : "off", options_.i2i ? "on" : "off");
 }
 
-std::string RsuNode::checkpointDir() const {
-  return (fs::path(options_.checkpoint_dir) / options_.controller.rsu_id).string();
-}
-
-void RsuNode::loadInitialModel() {
-  const RsuControllerOptions& c = options_.controller;
-  if (c.advice_source == AdviceSource::kRules) {
-    ROS_INFO_NAMED("startup", "%s: advice from the rule (exit %.0f m per lane + %.0f m, through traffic out of "
-                   "lanes 1..%d, merge advice %s); no weights loaded",
-                   c.rsu_id.c_str(), c.rules.exit_distance_per_lane_m, c.rules.exit_margin_m,
-                   c.rules.through_keep_out_lanes, c.rules.advise_merge ? "on" : "off");
-    return;
-  }
-  if (!c.train && options_.policy_dir == RANDOM_POLICY)
-    ROS_WARN_NAMED("startup", "%s: evaluating an UNTRAINED network (policy_dir:=%s): its advice is random", c.rsu_id.c_str(),
-             RANDOM_POLICY);
-  if (!c.train && options_.policy_dir != RANDOM_POLICY) {
-    // A federated policy is the server's global model; an independent one is per RSU; an RSU
-    // with no model of its own (a zone the training did not have) starts from the policy's
-    // default model, which tools/ship_policy.py ships beside per-RSU models.
-    const fs::path dir(options_.policy_dir);
-    const fs::path candidates[] = {dir / "fedserver" / "global_model.palcas", dir / c.rsu_id / "model.palcas",
-                                   dir / "default" / "model.palcas"};
-    const fs::path* found = nullptr;
-    for (const fs::path& f : candidates)
-      if (!found && fs::exists(f)) found = &f;
-    if (!found)
-      throw std::runtime_error("policy_dir '" + options_.policy_dir + "' holds none of " + candidates[0].string() +
-                               ", " + candidates[1].string() + ", " + candidates[2].string());
-    const fs::path file = *found;
-    controller_->loadPolicy(file.string());
-    policy_file_ = file.string();
-    ROS_INFO_NAMED("startup", "%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());
-    return;
-  }
-  if (!options_.federation) return;
-  federated_model_ = std::make_unique<ControllerModel>(*controller_);
-  transport_ = std::make_unique<RosFederationTransport>(nh_, auth_key_.get(), submitted_pub_);
-  FederationClientOptions client;
-  client.rsu_id = c.rsu_id;
-  client.heartbeat_s = options_.federation_heartbeat_s;
-  federation_ = std::make_unique<FederationClient>(
-      client, *federated_model_, *transport_,
-      [this](FederationEvent e, const std::string& message) { onFederationEvent(e, message); });
-  if (!ros::service::waitForService(nh_.resolveName(FETCH_MODEL_SERVICE),
-                                    ros::Duration(options_.federation_wait_s))) {
+void RsuNode::startFederation() {
+  const bool reachable =
+      ros::service::waitForService(nh_.resolveName(FETCH_MODEL_SERVICE), ros::Duration(options_.federation_wait_s));
+  if (!reachable)
     ROS_WARN_NAMED("federation", "%s: federation server not reachable after %.0f s: starting from local weights; "
-             "will join when it answers", c.rsu_id.c_str(), options_.federation_wait_s);
-    return;
-  }
-  federation_->join();
+             "will join when it answers", options_.controller.rsu_id.c_str(), options_.federation_wait_s);
+  decider_->startFederation(
+      std::make_unique<RosFederationTransport>(nh_, auth_key_.get(), submitted_pub_), reachable,
+      [this](FederationEvent e, const std::string& message) { onFederationEvent(e, message); },
+      [this](const palcas_msgs::ModelWeights& model) { model_pub_.publish(model); });
 }
 
 void RsuNode::waitForPeers() {
@@ -243,7 +156,7 @@ void RsuNode::registerWithBridge() {
 }
 
 void RsuNode::onEvents(const palcas_msgs::VehicleEventArray::ConstPtr& msg) {
-  addOutcomes(*msg, outcomes_);
+  decider_->onEvents(*msg);
   inputs_.eventsArrived(msg->step);
   decideHeldIfReady();
 }
@@ -252,82 +165,36 @@ void RsuNode::onClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
   if (msg->rsu_id == options_.controller.rsu_id) return;
   // It arrived, whatever the channel makes of it: a lost one is not waited for.
   inputs_.clusterStateArrived(msg->cluster_index, msg->step);
-  receiveClusterState(msg);
+  std::string why;
+  if (!decider_->onClusterState(*msg, &why))
+    ROS_WARN_THROTTLE_NAMED(5.0, "i2i", "%s: ignored cluster state: %s", options_.controller.rsu_id.c_str(), why.c_str());
   decideHeldIfReady();
 }
 
-void RsuNode::receiveClusterState(const palcas_msgs::ClusterState::ConstPtr& msg) {
-  if (channel_) {
-    // I2I over the channel: lost, or held until the step it arrives at (decide() takes it).
-    ++i2i_received_;
-    const v2x::Delivery d =
-        channel_->transmit(v2x::MessageClass::CLUSTER_STATE, msg->rsu_id, options_.controller.rsu_id, msg->step);
-    if (d.lost) ++i2i_lost_;
-    else i2i_in_flight_.push(msg->step + d.delay_steps, *msg);
-    return;
-  }
-  try {
-    peers_.update(msg->cluster_index, msg->rsu_id, msg->density_veh_per_km, msg->header.stamp.toSec());
-  } catch (const std::invalid_argument& e) {
-    ROS_WARN_THROTTLE_NAMED(5.0, "i2i", "%s: ignored cluster state: %s", options_.controller.rsu_id.c_str(), e.what());
-  }
-}
-
 void RsuNode::onStates(const palcas_msgs::VehicleStateArray::ConstPtr& msg) {
-  const ros::WallTime received = ros::WallTime::now();
-  if (first_state_ && msg->num_lanes != options_.controller.num_lanes) {
-    ROS_FATAL_NAMED("startup", "%s: the road has %u lanes but rsu/num_lanes is %d (the state size depends on it)",
-              options_.controller.rsu_id.c_str(), msg->num_lanes, options_.controller.num_lanes);
+  const RsuDecider::Clock::time_point received = RsuDecider::Clock::now();
+  if (held_state_) decideHeldAnyway("the bridge sent a later step");  // it did not wait for us
+  bool decision_step = false;
+  try {
+    decision_step = decider_->onStates(*msg);
+  } catch (const std::invalid_argument& e) {
+    ROS_ERROR_THROTTLE_NAMED(5.0, "decision", "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
+                       static_cast<unsigned long>(msg->step), e.what());
+  } catch (const std::runtime_error& e) {
+    ROS_FATAL_NAMED("startup", "%s", e.what());  // a road this RSU cannot serve
     ros::shutdown();
     return;
   }
-  if (first_state_ && options_.v2x.enabled) {
-    const RsuControllerOptions& c = options_.controller;
-    // The centralized baseline is one agent over the whole road, not a radio: no range.
-    const double x_m = options_.whole_road ? 0.0 : 0.5 * (c.x_start_m + c.x_end_m);
-    v2x::ChannelParams p = options_.v2x;
-    if (options_.whole_road) p.rsu_range_m = std::numeric_limits<double>::infinity();
-    channel_ = std::make_unique<v2x::Channel>(p, msg->step_length_s);
-    uplink_ = std::make_unique<v2x::UplinkView>(*channel_, c.rsu_id, x_m);
-    ROS_INFO_NAMED("v2x", "%s: V2X channel on (seed %lu): states %.3f s + U(0, %.3f) s, lost %.1f %%; cluster states %.3f s + "
-             "U(0, %.3f) s, lost %.1f %%; range %.1f m from x = %.0f m; states forgotten after %.2f s",
-             c.rsu_id.c_str(), static_cast<unsigned long>(p.seed), p.vehicle_state.latency_s, p.vehicle_state.jitter_s,
-             100.0 * p.vehicle_state.loss_probability, p.cluster_state.latency_s, p.cluster_state.jitter_s,
-             100.0 * p.cluster_state.loss_probability, p.rsu_range_m, x_m, p.max_state_age_s);
-  }
-  first_state_ = false;
-  if (uplink_ && last_state_step_ && msg->step <= *last_state_step_) {
-    uplink_->clear();  // a new episode: nothing heard yet, nothing in flight
-    i2i_in_flight_.clear();
-  }
-  last_state_step_ = msg->step;
-  if (held_state_) decideHeldAnyway("the bridge sent a later step");  // it did not wait for us
-  if (schedule_.decidesAt(msg->step)) {
+  if (decision_step) {
     decideWhenReady(msg, received);
     return;
   }
   // Unregistered, the bridge does not know our period and waits for every step.
   if (!answer_decision_steps_only_) answerEmpty(*msg, received);
-  const bool observe = schedule_.observesBetweenDecisions();
-  if (observe || uplink_) {
-    try {
-      const RoadSnapshot road = heard(*msg);  // the uplink hears every step
-      if (observe) controller_->observeStep(road);  // never touches the agent: no join
-    } catch (const std::invalid_argument& e) {
-      ROS_ERROR_THROTTLE_NAMED(5.0, "decision", "%s: step %lu not observed: %s", options_.controller.rsu_id.c_str(),
-                         static_cast<unsigned long>(msg->step), e.what());
-    }
-  }
 }
 
-void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
-  palcas_msgs::AdvisoryArray out;
-  out.header = msg.header;
-  out.step = msg.step;
-  out.rsu_id = options_.controller.rsu_id;
-  out.i2i_upstream_density_veh_per_km = std::numeric_limits<double>::quiet_NaN();
-  out.i2i_downstream_density_veh_per_km = std::numeric_limits<double>::quiet_NaN();
-  out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
+void RsuNode::answerEmpty(const palcas_msgs::VehicleStateArray& msg, RsuDecider::Clock::time_point received) {
+  palcas_msgs::AdvisoryArray out = decider_->emptyAnswer(msg, received);
   publishAdvisories(out);
 }
 
@@ -336,7 +203,8 @@ void RsuNode::publishAdvisories(palcas_msgs::AdvisoryArray& out) {
   advisories_pub_.publish(out);
 }
 
-void RsuNode::decideWhenReady(const palcas_msgs::VehicleStateArray::ConstPtr& msg, const ros::WallTime& received) {
+void RsuNode::decideWhenReady(const palcas_msgs::VehicleStateArray::ConstPtr& msg,
+                              RsuDecider::Clock::time_point received) {
   if (inputs_.ready(msg->step)) {
     decide(*msg, received);
     return;
@@ -373,123 +241,46 @@ void RsuNode::decideHeldAnyway(const char* why) {
   decide(*msg, held_received_);
 }
 
-void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, const ros::WallTime& received) {
-  const double now_s = msg.header.stamp.toSec();
-  schedule_.finishLearning();  // rethrows what learn() threw; the controller is ours again
-  GlobalDensities global;
-  DecisionOutput decision;
-  try {
-    decision = advise(msg, now_s, global);
-  } catch (const std::invalid_argument& e) {
-    // A malformed state: answer empty (CAVs keep their commands), say why, keep going.
+void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, RsuDecider::Clock::time_point received) {
+  RsuDecision decision = decider_->decide(msg, received);
+  if (!decision.decided)
     ROS_ERROR_THROTTLE_NAMED(5.0, "decision", "%s: step %lu not decided: %s", options_.controller.rsu_id.c_str(),
-                       static_cast<unsigned long>(msg.step), e.what());
-    answerEmpty(msg, received);
-    return;
-  }
-  const float decision_ms = publishDecision(msg, decision, global, received);
-  logDecisionDetail(msg.step, decision, global, decision_ms);
-  const AfterDecision after = schedule_.decided();
-  if (after.learn_inline) controller_->learn();  // after publishing: the bridge need not wait
-  logDecision(msg.step, decision_ms);
-  if (after.federation_tick && federation_) federation_->onDecision(now_s);
-  if (after.checkpoint) checkpoint();
-  publishStatus(msg, now_s, decision_ms);
-  // Last: federation and checkpoints above saw the model as the decision used it.
-  if (after.learn_on_thread) schedule_.startLearning([this] { controller_->learn(); });
-}
-
-DecisionOutput RsuNode::advise(const palcas_msgs::VehicleStateArray& msg, double now_s, GlobalDensities& global) {
-  const RsuControllerOptions& c = options_.controller;
-  const RoadSnapshot snapshot = heard(msg);
-  for (const palcas_msgs::ClusterState& m : i2i_in_flight_.release(msg.step)) {
-    try {
-      peers_.update(m.cluster_index, m.rsu_id, m.density_veh_per_km, m.header.stamp.toSec());
-    } catch (const std::invalid_argument& e) {
-      ROS_WARN_THROTTLE_NAMED(5.0, "i2i", "%s: ignored cluster state: %s", c.rsu_id.c_str(), e.what());
-    }
-  }
-  // The own density is not known before deciding; the state builder takes the global
-  // densities as given, so use the peers' view with the last own density.
-  const double unknown = std::numeric_limits<double>::quiet_NaN();
-  global = options_.i2i ? peers_.global(last_own_density_, now_s) : GlobalDensities{unknown, unknown, unknown};
-  // Evaluating, membership comes from the states alone, so a decision need not wait for its
-  // step's events (DecisionInputs): the bridge drops a removed vehicle from the states of the
-  // step that removes it, and over the V2X channel the events would race the delayed states
-  // and decide a stale vehicle's membership by arrival order. Training keeps them: they close
-  // its transitions with their terminal rewards.
-  const VehicleOutcomes none;
-  DecisionOutput decision = controller_->advise(snapshot, msg.step, now_s, global, c.train ? outcomes_ : none);
-  outcomes_.clear();
-  last_own_density_ = decision.cluster.density_veh_per_km;
-  return decision;
-}
-
-float RsuNode::publishDecision(const palcas_msgs::VehicleStateArray& msg, const DecisionOutput& decision,
-                               const GlobalDensities& global, const ros::WallTime& received) {
-  palcas_msgs::AdvisoryArray out;
-  out.header = msg.header;
-  out.step = msg.step;
-  out.rsu_id = options_.controller.rsu_id;
-  out.i2i_upstream_density_veh_per_km = global.upstream;
-  out.i2i_downstream_density_veh_per_km = global.downstream;
-  for (const CavAdvisory& a : decision.advisories) out.advisories.push_back(toMsg(a, decision.model_version));
-  out.decision_ms = static_cast<float>((ros::WallTime::now() - received).toSec() * 1e3);
+                       static_cast<unsigned long>(msg.step), decision.error.c_str());
   // The cluster state first: the peers then have it before the bridge, released by our
   // answer, runs the steps to the next decision.
-  if (options_.i2i) cluster_pub_.publish(toMsg(decision.cluster, options_.controller, msg.step, decision.time_s));
-  publishAdvisories(out);
-  return out.decision_ms;
+  if (decision.cluster_state) cluster_pub_.publish(*decision.cluster_state);
+  publishAdvisories(decision.advisories);
+  if (!decision.decided) return;
+  logDecisionDetail(decision);
+  last_status_ = decider_->afterPublished(msg, decision);
+  status_pub_.publish(last_status_);
+  recent_decision_ms_.add(decision.advisories.decision_ms);
+  diagnostics_.update();
 }
 
-void RsuNode::logDecisionDetail(std::uint64_t step, const DecisionOutput& decision, const GlobalDensities& global,
-                                float decision_ms) const {
-  const RsuControllerStats stats = controller_->stats();
+void RsuNode::logDecisionDetail(const RsuDecision& decision) const {
+  const palcas_msgs::AdvisoryArray& a = decision.advisories;
   std::string advice;
-  for (const CavAdvisory& a : decision.advisories) {
-    advice += " " + a.vehicle_id + ":" + actionName(a.decision.action);
-    if (a.decision.action == Action::kAccelerate) {
+  for (const palcas_msgs::Advisory& adv : a.advisories) {
+    advice += " " + adv.vehicle_id + ":" + actionName(static_cast<Action>(adv.action));
+    if (static_cast<Action>(adv.action) == Action::kAccelerate) {
       char accel[16];
-      std::snprintf(accel, sizeof accel, "(%+.2f)", a.decision.accel_mps2);
+      std::snprintf(accel, sizeof accel, "(%+.2f)", adv.accel_mps2);
       advice += accel;
     }
   }
-  ROS_DEBUG_NAMED("decision", "%s: step %lu: %u members, density %.1f veh/km (I2I up %.1f, down %.1f), model v%u, "
-                  "%.2f ms;%s", options_.controller.rsu_id.c_str(), static_cast<unsigned long>(step), stats.member_count,
-                  decision.cluster.density_veh_per_km, global.upstream, global.downstream, decision.model_version,
-                  decision_ms, advice.c_str());
-}
-
-void RsuNode::logDecision(std::uint64_t step, float decision_ms) {
-  try {
-    learning_log_.addDecision(step, controller_->stats(), decision_ms);
-  } catch (const std::runtime_error& e) {
-    ROS_ERROR_THROTTLE_NAMED(60.0, "learning", "%s: %s", options_.controller.rsu_id.c_str(), e.what());
-  }
-}
-
-void RsuNode::publishStatus(const palcas_msgs::VehicleStateArray& msg, double now_s, float decision_ms) {
-  const RsuControllerOptions& c = options_.controller;
-  StatusContext context;
-  context.header = msg.header;
-  context.step = msg.step;
-  context.rsu_id = c.rsu_id;
-  context.train = c.train;
-  context.decision_ms = decision_ms;
-  context.stale_peers = static_cast<uint32_t>(peers_.stalePeers(now_s).size());
-  context.federation_reachable = federation_ && federation_->reachable();
-  const palcas_msgs::RsuStatus status = toStatusMsg(controller_->stats(), context);
-  status_pub_.publish(status);
-  last_status_ = status;
-  recent_decision_ms_.add(decision_ms);
-  diagnostics_.update();
+  ROS_DEBUG_NAMED("decision", "%s: step %lu: %u members, density %.1f veh/km (I2I up %.1f, down %.1f), %.2f ms;%s",
+                  options_.controller.rsu_id.c_str(), static_cast<unsigned long>(a.step),
+                  decider_->controller().stats().member_count,
+                  decision.cluster_state ? decision.cluster_state->density_veh_per_km : std::nan(""),
+                  a.i2i_upstream_density_veh_per_km, a.i2i_downstream_density_veh_per_km, a.decision_ms, advice.c_str());
 }
 
 void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
   RsuHealthFacts f;
   f.last = last_status_;
-  f.decided = schedule_.decisions() > 0;
-  f.policy = policy_file_;
+  f.decided = decider_->schedule().decisions() > 0;
+  f.policy = decider_->policyFile();
   f.i2i = options_.i2i && !options_.whole_road;
   f.federation = options_.federation;
   f.decision_p99_ms = recent_decision_ms_.percentile(99.0);
@@ -509,56 +300,26 @@ void RsuNode::onFederationEvent(FederationEvent event, const std::string& messag
     case FederationEvent::kModelRefused: ROS_ERROR_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
     case FederationEvent::kSubmitRefused: ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
     case FederationEvent::kSubmitted: ROS_INFO_NAMED("federation", "%s", message.c_str()); break;
-    case FederationEvent::kLoaded:
-      model_pub_.publish(common::toWeightsMsg(controller_->exportModel(), options_.controller.rsu_id,
-                                              federation_->openRound(), controller_->modelVersion(), 0));
-      ROS_INFO_NAMED("federation", "%s", message.c_str());
-      break;
+    case FederationEvent::kLoaded: ROS_INFO_NAMED("federation", "%s", message.c_str()); break;
   }
-}
-
-void RsuNode::checkpoint() {
-  try {
-    controller_->saveCheckpoint(checkpointDir());
-    controller_->agent().saveModel((fs::path(checkpointDir()) / "model.palcas").string());
-  } catch (const std::exception& e) {
-    ROS_ERROR_NAMED("checkpoint", "%s: checkpoint failed: %s", options_.controller.rsu_id.c_str(), e.what());
-  }
-}
-
-void RsuNode::endEpisodeLog() {
-  try {
-    learning_log_.endEpisode(controller_->stats());
-  } catch (const std::runtime_error& e) {
-    ROS_ERROR_NAMED("learning", "%s: %s", options_.controller.rsu_id.c_str(), e.what());
-  }
-}
-
-RoadSnapshot RsuNode::heard(const palcas_msgs::VehicleStateArray& msg) {
-  RoadSnapshot truth = toSnapshot(msg);
-  if (!uplink_) return truth;
-  return uplink_->receive(truth, msg.step);
 }
 
 void RsuNode::addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) const {
-  if (!uplink_) return;
-  const v2x::UplinkCounts& n = uplink_->counts();
-  s.add("V2X vehicle states sent", n.sent);
-  s.add("V2X vehicle states lost", n.lost);
-  s.add("V2X vehicle states out of range", n.out_of_range);
-  s.add("V2X vehicles forgotten (state too old)", n.forgotten);
-  s.add("V2X mean age of the states used [s]", n.used ? n.used_age_sum_s / static_cast<double>(n.used) : 0.0);
-  s.add("V2X cluster states lost", i2i_lost_);
-  s.add("V2X cluster states received", i2i_received_);
+  const v2x::UplinkCounts* n = decider_->uplinkCounts();
+  if (!n) return;
+  s.add("V2X vehicle states sent", n->sent);
+  s.add("V2X vehicle states lost", n->lost);
+  s.add("V2X vehicle states out of range", n->out_of_range);
+  s.add("V2X vehicles forgotten (state too old)", n->forgotten);
+  s.add("V2X mean age of the states used [s]", n->used ? n->used_age_sum_s / static_cast<double>(n->used) : 0.0);
+  s.add("V2X cluster states lost", decider_->i2iLost());
+  s.add("V2X cluster states received", decider_->i2iReceived());
 }
 
 void RsuNode::shutdown() {
-  schedule_.finishLearning();
-  endEpisodeLog();
-  if (options_.controller.train && !options_.checkpoint_dir.empty()) {
-    checkpoint();
-    ROS_INFO_NAMED("checkpoint", "%s: checkpoint written to %s", options_.controller.rsu_id.c_str(), checkpointDir().c_str());
-  }
+  const std::string written = decider_->shutdown();
+  if (!written.empty())
+    ROS_INFO_NAMED("checkpoint", "%s: checkpoint written to %s", options_.controller.rsu_id.c_str(), written.c_str());
 }
 
 }  // namespace palcas::rsu

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 
 #include "palcas_common/core_params.h"
@@ -138,6 +139,31 @@ void checkAgainstRoad(const RsuNodeOptions& o, const std::vector<double>& road_z
                   c.x_start_m, c.x_end_m, which.c_str(), start, end);
     throw std::invalid_argument(text);
   }
+}
+
+void requireEvalWeights(const RsuNodeOptions& o) {
+  if (o.controller.train || o.policy_dir == RANDOM_POLICY) return;
+  if (o.controller.advice_source == AdviceSource::kRules) return;  // the rule needs no weights
+  if (o.policy_dir.empty())
+    throw std::runtime_error(
+        "mode eval needs trained weights and policy_dir is not set: give policy_dir:=DIR (a training's "
+        "checkpoints/ folder; system.launch's default 'shipped' is policies/<arm>/checkpoints; "
+        "./palcas train makes new ones), or policy_dir:=random to evaluate an untrained network on "
+        "purpose. Only mode train starts from random weights");
+  if (!std::filesystem::is_directory(o.policy_dir))
+    throw std::runtime_error("policy_dir '" + o.policy_dir + "' is not a folder (eval needs a training's "
+                             "checkpoints/ folder, e.g. policies/palcas/checkpoints)");
+}
+
+std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id) {
+  namespace fs = std::filesystem;
+  const fs::path dir(checkpoints_dir);
+  const fs::path candidates[] = {dir / "fedserver" / "global_model.palcas", dir / rsu_id / "model.palcas",
+                                 dir / "default" / "model.palcas"};
+  for (const fs::path& f : candidates)
+    if (fs::exists(f)) return f.string();
+  throw std::runtime_error("policy folder '" + checkpoints_dir + "' holds no model for " + rsu_id + ": none of " +
+                           candidates[0].string() + ", " + candidates[1].string() + ", " + candidates[2].string());
 }
 
 }  // namespace palcas::rsu

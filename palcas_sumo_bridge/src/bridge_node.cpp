@@ -56,6 +56,8 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   advisories_sub_ = nh_.subscribe(ADVISORIES_TOPIC, 100, &BridgeNode::onAdvisories, this,
                                   ros::TransportHints().tcpNoDelay());
   publishRoad();  // before registration opens: an RSU checks its zone when it registers
+  // In process with no RSU (SUMO-native, keep): nothing to run.
+  if (options_.inprocess_rsus && !options_.expected_rsus.empty()) startInProcessRsus();
   register_srv_ = nh_.advertiseService(REGISTER_RSU_SERVICE, &BridgeNode::onRegister, this);
   setUpDiagnostics();
   ROS_INFO_NAMED("startup", "palcas bridge: %s (%s), scenario %s, PR %.0f%%, seed %u, %.0f s, %zu RSU(s) expected",
@@ -86,6 +88,22 @@ void BridgeNode::publishRoad() {
   road.step_length_s = session().stepLengthS();
   road.scenario_dir = options_.scenario.scenario_dir;
   road_pub_.publish(road);
+}
+
+void BridgeNode::startInProcessRsus() {
+  std::vector<double> zones;
+  for (const sim::ClusterInfo& c : session().road().clusters()) {
+    if (zones.empty()) zones.push_back(c.x_start_m);
+    zones.push_back(c.x_end_m);
+  }
+  inprocess_ = std::make_unique<InProcessRsus>(nh_, options_.expected_rsus, zones, session().road().numMainLanes(),
+                                               auth_key_.get());
+  for (const auto& [id, period] : inprocess_->decisionPeriods()) {
+    std::string reason;
+    if (!runner_->lockstep().registerRsu(id, &reason, static_cast<std::uint32_t>(period)))
+      throw std::runtime_error("in-process RSU '" + id + "' not registered: " + reason);
+  }
+  ROS_INFO_NAMED("startup", "palcas bridge: %zu RSU(s) in process, answering by call", options_.expected_rsus.size());
 }
 
 void BridgeNode::advertise() {
@@ -166,8 +184,9 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
   const auto& sim_events = session.lastEvents();
   const std::vector<metrics::VehicleEvent> events = measure_->onStep(
       current_states_, {sim_events.collided, sim_events.teleported, sim_events.arrived});
-  if (!events.empty() || runner_->lockstep().mayDecideOnOpenStep()) {
-    palcas_msgs::VehicleEventArray events_msg;
+  palcas_msgs::VehicleEventArray events_msg;
+  const bool events_out = !events.empty() || runner_->lockstep().mayDecideOnOpenStep();
+  if (events_out) {
     events_msg.header.stamp = stamp;
     events_msg.header.frame_id = ROAD_FRAME;
     events_msg.step = step;
@@ -175,6 +194,9 @@ void BridgeNode::publishStep(const sim::SumoSession& session) {
     events_pub_.publish(events_msg);
   }
   states_pub_.publish(current_states_);
+  if (inprocess_)
+    for (const palcas_msgs::AdvisoryArray& answer : inprocess_->step(current_states_, events_out ? &events_msg : nullptr))
+      accept(answer);
   if (options_.publish_tf && tf_pub_.getNumSubscribers() > 0)
     tf_pub_.publish(markers_->transforms(stamp, session.vehicles()));
 }
@@ -198,22 +220,26 @@ void BridgeNode::onAdvisories(const ros::MessageEvent<const palcas_msgs::Advisor
                std::to_string(msg->step) + " published by " + event.getPublisherName());
     return;
   }
+  accept(*msg);
+}
+
+void BridgeNode::accept(const palcas_msgs::AdvisoryArray& msg) {
   auto array = std::make_shared<sim::AdviceArray>();
-  array->rsu_id = msg->rsu_id;
-  array->step = msg->step;
-  array->decision_ms = msg->decision_ms;
-  array->advisories.reserve(msg->advisories.size());
-  for (const palcas_msgs::Advisory& a : msg->advisories) array->advisories.push_back(toRequest(a, msg->step, msg->rsu_id));
+  array->rsu_id = msg.rsu_id;
+  array->step = msg.step;
+  array->decision_ms = msg.decision_ms;
+  array->advisories.reserve(msg.advisories.size());
+  for (const palcas_msgs::Advisory& a : msg.advisories) array->advisories.push_back(toRequest(a, msg.step, msg.rsu_id));
   const sim::EpisodeRunner::AnswerOutcome outcome = runner_->onAnswer(std::move(array));
   for (const std::string& id : outcome.revived)
     ROS_WARN_NAMED("lockstep", "palcas bridge: RSU '%s' answers again (step %lu): waited for from the next step "
-             "on", id.c_str(), static_cast<unsigned long>(msg->step));
+             "on", id.c_str(), static_cast<unsigned long>(msg.step));
   if (outcome.verdict == sim::EpisodeRunner::Verdict::kDuplicate)
     ROS_WARN_THROTTLE_NAMED(5.0, "lockstep", "palcas bridge: second answer of RSU '%s' for step %lu ignored",
-                      msg->rsu_id.c_str(), static_cast<unsigned long>(msg->step));
+                      msg.rsu_id.c_str(), static_cast<unsigned long>(msg.step));
   if (outcome.verdict == sim::EpisodeRunner::Verdict::kUnknownRsu)
     ROS_WARN_THROTTLE_NAMED(5.0, "lockstep", "palcas bridge: advisories from unknown RSU '%s' ignored "
-                      "(not in ~expected_rsus)", msg->rsu_id.c_str());
+                      "(not in ~expected_rsus)", msg.rsu_id.c_str());
 }
 
 void BridgeNode::lockstepMissed(std::uint64_t step, const std::vector<std::string>& late,
@@ -318,6 +344,7 @@ int BridgeNode::run() {
     if (episode > first) startEpisode(episode);
     writeEpisode(episode, runner_->runEpisode(episode, *this));
   }
+  if (inprocess_) inprocess_->shutdown();  // final checkpoints of a training
   // Stay up a moment: recorders and RSUs still have the last messages in flight.
   const auto linger_end = std::chrono::steady_clock::now() + std::chrono::duration<double>(options_.linger_s);
   while (ros::ok() && std::chrono::steady_clock::now() < linger_end)

@@ -142,6 +142,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
       p.integer("assist_lane_change_mode", o.session.assist_lane_change_mode, 0, 4095);
   o.session.cluster_length_m = o.scenario.road.cluster_length_m;
   o.expected_rsus = p.get<std::vector<std::string>>("expected_rsus", {});
+  o.inprocess_rsus = p.get<bool>("inprocess_rsus", o.inprocess_rsus);
   o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);
   o.startup_timeout_s = p.number("startup_timeout_s", o.startup_timeout_s, 0.0, 3600.0);
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);

@@ -136,6 +136,7 @@ json bridgeJson(const BridgeOptions& o) {
           {"sumo_outputs", o.sumo_outputs},
           {"sumo_fcd_period_s", o.sumo_fcd_period_s},
           {"expected_rsus", o.expected_rsus},
+          {"inprocess_rsus", o.inprocess_rsus},
           {"lockstep_deadline_s", o.lockstep_deadline_s},
           {"lost_after_missed_steps", o.lost_after_missed_steps},
           {"max_advisory_age_steps", o.max_advisory_age_steps},

@@ -23,9 +23,10 @@ VALUES = {"--duration": "duration", "--pr": "pr", "--demand": "demand", "--ramp-
           "--scenario": "scenario", "--arm": "arm", "--bridge-params": "bridge_params", "--rsu-params": "rsu_params", "--v2x": "v2x",
           "--sumo-output": "sumo_outputs"}
 FLAGS = {"--gui": ("gui", True), "--rviz": ("rviz", True), "--record": ("record", True),
-         "--no-compare": ("compare", False), "--no-trajectories": ("trajectory_steps", 0)}
+         "--no-compare": ("compare", False), "--no-trajectories": ("trajectory_steps", 0),
+         "--in-process": ("inprocess", True)}
 DEFAULTS = {"duration": "1800", "pr": "60", "seed": "101", "gui": False, "rviz": False, "record": False,
-            "compare": True, "trajectory_steps": 10}
+            "compare": True, "trajectory_steps": 10, "inprocess": False}
 D = options.with_default
 # --help: each option's METAVAR (None for a flag) and what it does, with its default.
 HELPS = {
@@ -51,6 +52,8 @@ HELPS = {
     "--record": (None, D("record a rosbag of each run into its folder", "off")),
     "--no-trajectories": (None, D("record no trajectories.csv / decisions.csv (and draw no figures)",
                                   "off: every %d steps" % DEFAULTS["trajectory_steps"])),
+    "--in-process": (None, D("run the RSUs inside the bridge process (the same decision code, a call per step "
+                             "instead of ROS topics; same results, faster)", "off: one RSU node per zone")),
     "--bridge-params": ("FILE", D("a bridge parameter override for every arm", "none")),
     "--rsu-params": ("FILE", D("an RSU parameter override for every RSU (e.g. a rules: map over "
                                "config/rules.yaml)", "none")),
@@ -191,7 +194,7 @@ def run_arms(p, console, show, rviz):
               "record:=" + flag(p.record), "trajectory_period_steps:=%d" % p.trajectory_steps,
               "real_time_factor:=" + p.real_time_factor, "auth_key_file:=" + auth_key,
               "bridge_params:=" + (p.bridge_params or "none"), "rsu_params:=" + (p.rsu_params or "none"),
-              "v2x_params:=" + (p.v2x or "none"),
+              "v2x_params:=" + (p.v2x or "none"), "inprocess:=" + flag(p.inprocess),
               "sumo_outputs:=" + (p.sumo_outputs or "config"), "scenario:=" + p.scenario,
               "git_commit:=" + launch.git_commit(), "command_line:=" + p.command_line]
     if p.missing:

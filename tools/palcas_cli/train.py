@@ -51,7 +51,8 @@ VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "-
           "--ramp-demand": "ramp_demand", "--seed": "seed", "--arm": "arm", "--out": "out", "--scenario": "scenario",
           "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
           "--v2x": "v2x_params"}
-FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True)}
+FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True),
+         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True)}
 # A new training's defaults as typed (DEFAULTS's values, 3600.0 as 3600).
 TYPED_DEFAULTS = {k: v if isinstance(v, str) else "%g" % v for k, v in DEFAULTS.items()
                   if k in ("episodes", "duration", "pr", "seed", "explore_fraction", "arm", "scenario")}
@@ -82,6 +83,11 @@ HELPS = {
     "--bridge-params": ("FILE", D("a bridge parameter override (e.g. config/training/unclipped_advisories.yaml)",
                                   "none")),
     "--v2x": ("FILE", D("train with the V2X channel on (as for run)", "off")),
+    "--in-process": (None, D("run the RSUs inside the bridge process (the RSU node's own decision code, a call "
+                             "per step instead of ROS topics; federation still over the server's services)",
+                             "off: one RSU node per zone")),
+    "--record-decisions": (None, D("record trajectories.csv and decisions.csv of every episode (every 10 steps), "
+                                   "as ./palcas run does", "off")),
     "--resume": (None, D("continue the training in --out from its checkpoints; road, arm, PR, seed, duration "
                          "and overrides come from its train.json (a contradicting option is refused)", "off")),
 }
@@ -306,6 +312,8 @@ def run_launches(out, opts, record, resume, command_line):
             "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
             "v2x_params:=%s" % (opts.get("v2x_params") or "none"),
             "paper_printed:=%s" % str(bool(opts.get("paper_printed"))).lower(), "auth_key_file:=%s" % auth_key,
+            "inprocess:=%s" % str(bool(opts.get("inprocess"))).lower(),
+            "trajectory_period_steps:=%d" % (10 if opts.get("record_decisions") else 0),
             "git_commit:=%s" % record["git_commit"], "command_line:=%s" % command_line]
         train_launch = launch.Launch(["palcas_launch", "system.launch"] + launch_args, os.path.join(out, "console.log"),
                                      os.path.join(out, "ros_log"), append=True).start()
@@ -390,6 +398,9 @@ def check(argv):
     opts, record = settle_options(chosen, out, resume)
     if not resume:
         opts.update(overrides, paper_printed=bool(given.get("paper_printed")))
+    # How it runs and what it records, not what it learns: any launch may choose.
+    opts["inprocess"] = bool(given.get("inprocess"))
+    opts["record_decisions"] = bool(given.get("record_decisions"))
     return opts, record, out, resume
 
 

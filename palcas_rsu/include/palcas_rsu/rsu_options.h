@@ -72,4 +72,18 @@ void adoptBridgeRoad(RsuNodeOptions& o, const std::vector<double>& road_zones_m,
 /// (an RSU whose zone is not on the road would get no CAVs and nothing would say why).
 void checkAgainstRoad(const RsuNodeOptions& o, const std::vector<double>& road_zones_m, int road_lanes);
 
+/// policy_dir's value for an evaluation of an untrained network, asked for on purpose.
+inline constexpr const char* RANDOM_POLICY = "random";
+
+/// An evaluation runs trained weights (or the rule, or `random` on purpose): refused, naming
+/// policy_dir, before anything waits for the bridge. @throws std::runtime_error.
+void requireEvalWeights(const RsuNodeOptions& o);
+
+/// The model an evaluating RSU loads from a policy's checkpoints folder, the one place of this
+/// order: the federation's global model (fedserver/global_model.palcas), else the RSU's own
+/// (<rsu_id>/model.palcas), else the policy's default (default/model.palcas, shipped beside
+/// per-RSU models for a zone the training did not have).
+/// @throws std::runtime_error naming the three candidates when none exists.
+std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id);
+
 }  // namespace palcas::rsu

@@ -2,7 +2,8 @@
 // The SUMO bridge node: ROS wiring around palcas_sim::EpisodeRunner (the ROS-free episode
 // loop: lockstep, advisory check, actuation, pacing) and the episode's measurement. The node
 // publishes each step, measures it, receives and authenticates the RSUs' answers, serves
-// registration, markers, tf and diagnostics, and writes each episode's metrics.
+// registration, markers, tf and diagnostics, and writes each episode's metrics. With
+// ~inprocess_rsus the RSUs run inside it (inprocess_rsus.h) and answer each step by call.
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <palcas_core/common/message_auth.h>
@@ -20,6 +21,7 @@
 #include "palcas_sim/episode_runner.h"
 #include "palcas_sumo_bridge/bridge_options.h"
 #include "palcas_sumo_bridge/episode_measure.h"
+#include "palcas_sumo_bridge/inprocess_rsus.h"
 #include "palcas_sumo_bridge/run_files.h"
 #include "palcas_sumo_bridge/rviz_markers.h"
 
@@ -46,6 +48,10 @@ class BridgeNode : private sim::EpisodePort {
   void startEpisode(int episode);
   void writeEpisode(int episode, const sim::EpisodeRun& run);
   void onAdvisories(const ros::MessageEvent<const palcas_msgs::AdvisoryArray>& event);
+  /// An authentic answer (from the topic or an in-process RSU) to the episode runner.
+  void accept(const palcas_msgs::AdvisoryArray& msg);
+  /// ~inprocess_rsus: builds the RSUs in this process and registers them with the lockstep.
+  void startInProcessRsus();
   bool onRegister(palcas_msgs::RegisterRsu::Request& req, palcas_msgs::RegisterRsu::Response& res);
   void reject(const std::string& rsu_id, const std::string& vehicle_id, int reason,
               const std::string& detail);
@@ -78,6 +84,7 @@ class BridgeNode : private sim::EpisodePort {
   MeasureRules rules_;
   std::unique_ptr<EpisodeMeasure> measure_;
   std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: advisories are not authenticated
+  std::unique_ptr<InProcessRsus> inprocess_;    ///< null: RSU nodes answer over topics
   int episode_ = 0;
 
   ros::Publisher states_pub_, events_pub_, metrics_pub_, rejections_pub_, clock_pub_,

@@ -35,6 +35,9 @@ struct BridgeOptions {
   sim::SessionOptions session;
   // Lockstep with the RSUs.
   std::vector<std::string> expected_rsus;  ///< empty = no RSUs (SUMO-native)
+  /// true: the expected RSUs run inside this process (inprocess_rsus.h), built from the
+  /// parameters under /<rsu_id>/rsu/; no RSU node runs. false: RSU nodes over topics.
+  bool inprocess_rsus = false;
   double lockstep_deadline_s = 0.2;        ///< wall time an RSU has to answer a step [s]
   double startup_timeout_s = 30.0;         ///< wall time to wait for every RSU to register [s]
   int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
