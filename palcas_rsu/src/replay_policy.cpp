@@ -1,8 +1,9 @@
 // replay_policy: the RSUs of a policy run OPEN LOOP on a recorded episode (a rosbag of
 // `./palcas run --record` / system.launch record:=true), their advisories compared with the
-// recorded ones. Every decision is made as RsuNode::decide makes it: the same snapshot
-// conversion, the same I2I bookkeeping (peers' cluster states stamped before the decision),
-// the same decision period and policy loading order, eval mode. Usage and output:
+// recorded ones. Every decision is made by the RSU node's own decision path (RsuDecider:
+// the same snapshot conversion, V2X uplink, I2I bookkeeping, decision period and policy
+// loading order), eval mode, with the recorded cluster states and, where the bag says which
+// neighbours' densities the live RSU used, those. Usage and output:
 // palcas_rsu/README.md, "replay_policy".
 //
 // The RSU parameters (config/rsu.yaml, reward.yaml, learning.yaml, departures.yaml and
@@ -37,11 +38,10 @@
 #include <vector>
 
 #include "palcas_rsu/msg_conversion.h"
-#include "palcas_rsu/peer_states.h"
+#include "palcas_rsu/rsu_decider.h"
 #include "palcas_rsu/rsu_options.h"
 
 namespace fs = std::filesystem;
-using palcas::rsu::RsuController;
 using palcas::rsu::RsuNodeOptions;
 
 namespace {
@@ -162,16 +162,6 @@ struct Tally {
   }
 };
 
-/// The model file an RSU of this policy loads, in RsuNode::loadInitialModel's order.
-fs::path policyFileFor(const fs::path& checkpoints, const std::string& rsu_id) {
-  const fs::path candidates[] = {checkpoints / "fedserver" / "global_model.palcas",
-                                 checkpoints / rsu_id / "model.palcas", checkpoints / "default" / "model.palcas"};
-  for (const fs::path& f : candidates)
-    if (fs::exists(f)) return f;
-  throw InputError("policy folder '" + checkpoints.string() + "' holds no model for " + rsu_id + ": none of " +
-                   candidates[0].string() + ", " + candidates[1].string() + ", " + candidates[2].string());
-}
-
 /// DIR is a training's checkpoints/ folder or a policy folder containing checkpoints/.
 fs::path checkpointsOf(const std::string& dir) {
   if (!fs::is_directory(dir)) throw InputError("--policy '" + dir + "': no such folder");
@@ -233,14 +223,9 @@ Road readRoad(rosbag::Bag& bag, int lanes_in_states) {
 /// One replayed RSU: its controller and I2I bookkeeping, as RsuNode holds them.
 struct ReplayedRsu {
   std::string id;
-  RsuNodeOptions options;
-  std::unique_ptr<RsuController> controller;
-  std::unique_ptr<palcas::rsu::PeerStates> peers;
-  double last_own_density = std::numeric_limits<double>::quiet_NaN();
-  // The V2X channel's uplink as the live RSU had it (options.v2x.enabled): fed every
-  // recorded step, so a decision sees the same stale and missing states.
-  std::unique_ptr<palcas::v2x::Channel> channel;
-  std::unique_ptr<palcas::v2x::UplinkView> uplink;
+  /// The RSU node's own decision path (rsu_decider.h), evaluating the policy: the same V2X
+  /// uplink, I2I bookkeeping and controller call as the live RSU.
+  std::unique_ptr<palcas::rsu::RsuDecider> decider;
   fs::path model;
   Tally tally;
 };
@@ -314,28 +299,32 @@ int run(const Args& args) {
   for (const std::string& id : rsu_ids) {
     ReplayedRsu r;
     r.id = id;
-    r.options = base;
-    palcas::rsu::RsuControllerOptions& c = r.options.controller;
+    RsuNodeOptions options = base;
+    palcas::rsu::RsuControllerOptions& c = options.controller;
     c.rsu_id = id;
     c.train = false;
-    r.options.whole_road = id == "central";  // the centralized baseline's one agent
-    r.options.i2i = i2i && !r.options.whole_road;
+    options.whole_road = id == "central";  // the centralized baseline's one agent
+    options.i2i = i2i && !options.whole_road;
     if (auto it = cluster_of.find(id); it != cluster_of.end()) {
       c.cluster_index = it->second;
     } else if (id.rfind("rsu_", 0) == 0 && id.size() > 4 &&
                id.find_first_not_of("0123456789", 4) == std::string::npos) {
       c.cluster_index = std::stoi(id.substr(4));
-    } else if (!r.options.whole_road) {
+    } else if (!options.whole_road) {
       throw InputError("RSU '" + id + "' in the bag: its cluster is unknown (not rsu_<k>, central, nor in " +
                        CLUSTER_TOPIC + ")");
     }
-    if (!r.options.zones_m.empty()) palcas::rsu::applyZones(r.options, "zones_m");
+    if (!options.zones_m.empty()) palcas::rsu::applyZones(options, "zones_m");
     try {
-      palcas::rsu::adoptBridgeRoad(r.options, road.zones_m, road.num_lanes);
+      palcas::rsu::adoptBridgeRoad(options, road.zones_m, road.num_lanes);
     } catch (const std::invalid_argument& e) {
       throw InputError(id + " on the recorded road: " + e.what());
     }
-    r.model = policyFileFor(checkpoints, id);
+    try {
+      r.model = palcas::rsu::policyFileIn(checkpoints.string(), id);
+    } catch (const std::runtime_error& e) {
+      throw InputError(e.what());
+    }
     palcas::ModelBlob blob;
     try {
       blob = palcas::loadModelBlob(r.model.string());
@@ -348,25 +337,21 @@ int run(const Args& args) {
                        " features, but the recorded road has " + std::to_string(road.num_lanes) +
                        " lanes: its state has " + std::to_string(palcas::LANE_INDEPENDENT_FEATURE_COUNT) + " + " + std::to_string(road.num_lanes) + " = " +
                        std::to_string(state_size) + " (a policy trained on another road)");
-    r.controller = std::make_unique<RsuController>(r.options.controller);
-    try {
-      r.controller->loadPolicy(r.model.string());
-    } catch (const std::exception& e) {
-      throw InputError("the model '" + r.model.string() + "' does not fit the RSU network these parameters " +
-                       "build (give the learning override the policy was trained with: --learning FILE): " + e.what());
-    }
-    r.peers = std::make_unique<palcas::rsu::PeerStates>(r.options.controller.cluster_index, r.options.i2i_stale_after_s);
-    if (r.options.v2x.enabled) {
-      // As RsuNode: the zone's centre, no range for the centralized agent.
-      palcas::v2x::ChannelParams p = r.options.v2x;
-      if (r.options.whole_road) p.rsu_range_m = std::numeric_limits<double>::infinity();
+    if (options.v2x.enabled) {
       try {
-        r.channel = std::make_unique<palcas::v2x::Channel>(p, step_length_s);
+        palcas::v2x::Channel check(options.v2x, step_length_s);  // the RSU builds it at the first state
       } catch (const std::invalid_argument& e) {
         throw InputError(id + ": the recorded V2X channel: " + e.what());
       }
-      const double x_m = r.options.whole_road ? 0.0 : 0.5 * (r.options.controller.x_start_m + r.options.controller.x_end_m);
-      r.uplink = std::make_unique<palcas::v2x::UplinkView>(*r.channel, id, x_m);
+    }
+    options.policy_dir = checkpoints.string();
+    options.resume = false;
+    options.checkpoint_dir.clear();
+    try {
+      r.decider = std::make_unique<palcas::rsu::RsuDecider>(options);
+    } catch (const std::exception& e) {
+      throw InputError("the model '" + r.model.string() + "' does not fit the RSU network these parameters " +
+                       "build (give the learning override the policy was trained with: --learning FILE): " + e.what());
     }
     rsus.push_back(std::move(r));
   }
@@ -380,8 +365,8 @@ int run(const Args& args) {
               args.bag.c_str(), road.zones_m.size() - 1, road.num_lanes, state_size, road.source.c_str(), period,
               i2i ? "on" : "off", base.v2x.enabled ? "; V2X channel on (as recorded: the uplink replayed step by step)" : "");
   for (const ReplayedRsu& r : rsus)
-    std::printf("  %s [%.0f, %.0f) m: %s\n", r.id.c_str(), r.options.controller.x_start_m,
-                r.options.controller.x_end_m, r.model.c_str());
+    std::printf("  %s [%.0f, %.0f) m: %s\n", r.id.c_str(), r.decider->options().controller.x_start_m,
+                r.decider->options().controller.x_end_m, r.model.c_str());
 
   std::map<int, Tally> by_action;  // key: recorded action, -1 = the recording advised nothing
   Tally total;
@@ -402,17 +387,18 @@ int run(const Args& args) {
                        std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
                        "): replay handles a bag of one episode (./palcas run records one per arm)");
     previous_step = states->step;
-    const palcas::RoadSnapshot snapshot = palcas::rsu::toSnapshot(*states);  // once per step
-    std::map<std::string, palcas::RoadSnapshot> heard;  // by RSU, with the channel on
-    for (ReplayedRsu& r : rsus)
-      if (r.uplink) {
-        try {
-          heard[r.id] = r.uplink->receive(snapshot, states->step);
-        } catch (const std::invalid_argument&) {
-          // A malformed state: the live RSU refused it too.
-        }
+    // Every RSU hears every step (the V2X uplink when it was on), as the live one did.
+    bool decision_step = false;
+    for (ReplayedRsu& r : rsus) {
+      try {
+        decision_step = r.decider->onStates(*states) || decision_step;
+      } catch (const std::invalid_argument&) {
+        // A malformed state between decisions: the live RSU refused it too.
+      } catch (const std::runtime_error& e) {
+        throw InputError(r.id + ": " + e.what());
       }
-    if (states->step % static_cast<std::uint64_t>(period) != 0) continue;
+    }
+    if (!decision_step) continue;
     ++decision_steps;
     const double now_s = states->header.stamp.toSec();
     // Peers' statistics up to (not including) this decision's time; PeerStates itself also
@@ -421,46 +407,26 @@ int run(const Args& args) {
            cluster_states[next_cluster_state].header.stamp.toSec() < now_s - 1e-9) {
       const palcas_msgs::ClusterState& c = cluster_states[next_cluster_state++];
       for (ReplayedRsu& r : rsus)
-        if (r.options.i2i && c.rsu_id != r.id) {
-          try {
-            r.peers->update(c.cluster_index, c.rsu_id, c.density_veh_per_km, c.header.stamp.toSec());
-          } catch (const std::invalid_argument&) {
-            // The live RSU ignored it too (and warned).
-          }
-        }
+        if (r.decider->options().i2i) r.decider->onClusterState(c);  // a malformed one: ignored live too
     }
     for (ReplayedRsu& r : rsus) {
-      const double unknown = std::numeric_limits<double>::quiet_NaN();
       const auto key = std::make_pair(states->step, r.id);
       const auto rec = recorded.find(key);
-      palcas::GlobalDensities global = r.options.i2i ? r.peers->global(r.last_own_density, now_s)
-                                                     : palcas::GlobalDensities{unknown, unknown, unknown};
       // Which peer states had reached the live RSU is not in the bag (topics between RSUs
       // race, above all while they connect at start-up): decide on the ones it used.
-      if (r.options.i2i && rec != recorded.end()) {
-        const palcas_msgs::AdvisoryArray& said = rec->second;
-        if (!sameDensity(global.upstream, said.i2i_upstream_density_veh_per_km) ||
-            !sameDensity(global.downstream, said.i2i_downstream_density_veh_per_km))
-          ++i2i_delivered_otherwise;
-        global.upstream = said.i2i_upstream_density_veh_per_km;
-        global.downstream = said.i2i_downstream_density_veh_per_km;
-      }
+      std::optional<palcas::GlobalDensities> used;
+      if (r.decider->options().i2i && rec != recorded.end())
+        used = palcas::GlobalDensities{rec->second.i2i_upstream_density_veh_per_km, std::nan(""),
+                                       rec->second.i2i_downstream_density_veh_per_km};
+      const palcas::rsu::RsuDecision d =
+          r.decider->decide(*states, palcas::rsu::RsuDecider::Clock::now(), used ? &*used : nullptr);
+      if (used && (!sameDensity(d.from_peers.upstream, used->upstream) ||
+                   !sameDensity(d.from_peers.downstream, used->downstream)))
+        ++i2i_delivered_otherwise;
       std::map<std::string, Advice> replayed;
-      try {
-        const auto h = heard.find(r.id);
-        if (r.uplink && h == heard.end()) throw std::invalid_argument("malformed state");
-        const palcas::RoadSnapshot& seen = r.uplink ? h->second : snapshot;
-        // As RsuNode: an evaluating RSU decides on the states alone, without the removal events.
-        const palcas::rsu::VehicleOutcomes none;
-        const palcas::rsu::DecisionOutput d = r.controller->advise(seen, states->step, now_s, global, none);
-        r.last_own_density = d.cluster.density_veh_per_km;
-        for (const auto& a : d.advisories) {
-          const palcas_msgs::Advisory msg = palcas::rsu::toMsg(a, d.model_version);
-          replayed[a.vehicle_id] = Advice{msg.action, msg.accel_mps2};
-        }
-      } catch (const std::invalid_argument& e) {
-        ++not_decided;  // the live RSU answered empty too
-      }
+      if (!d.decided) ++not_decided;  // the live RSU answered empty too
+      for (const palcas_msgs::Advisory& a : d.advisories.advisories)
+        replayed[a.vehicle_id] = Advice{a.action, a.accel_mps2};
       if (rec == recorded.end()) {
         decisions_unrecorded += replayed.size();
         continue;

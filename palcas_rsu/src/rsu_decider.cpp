@@ -164,7 +164,8 @@ bool RsuDecider::onStates(const palcas_msgs::VehicleStateArray& states) {
   return false;
 }
 
-RsuDecision RsuDecider::decide(const palcas_msgs::VehicleStateArray& states, Clock::time_point received) {
+RsuDecision RsuDecider::decide(const palcas_msgs::VehicleStateArray& states, Clock::time_point received,
+                               const GlobalDensities* used_densities) {
   const RsuControllerOptions& c = options_.controller;
   const double now_s = states.header.stamp.toSec();
   schedule_.finishLearning();  // rethrows what learn() threw; the controller is ours again
@@ -185,6 +186,11 @@ RsuDecision RsuDecider::decide(const palcas_msgs::VehicleStateArray& states, Clo
     // densities as given, so use the peers' view with the last own density.
     const double unknown = std::numeric_limits<double>::quiet_NaN();
     global = options_.i2i ? peers_.global(last_own_density_, now_s) : GlobalDensities{unknown, unknown, unknown};
+    out.from_peers = global;
+    if (options_.i2i && used_densities) {
+      global.upstream = used_densities->upstream;
+      global.downstream = used_densities->downstream;
+    }
     // Evaluating, membership comes from the states alone (the bridge drops a removed vehicle
     // from the states of the step that removes it; over the V2X channel the events would race
     // the delayed states). Training keeps them: they close its transitions.

@@ -49,6 +49,9 @@ struct RsuDecision {
   bool decided = false;
   std::string error;  ///< why not decided
   double time_s = 0.0;
+  /// The neighbours' densities this RSU's own peer bookkeeping gave (NaN = unknown), before
+  /// any override of decide()'s `used_densities`.
+  GlobalDensities from_peers;
 };
 
 class RsuDecider {
@@ -87,8 +90,11 @@ class RsuDecider {
   ///         std::invalid_argument for a malformed state between decisions.
   bool onStates(const palcas_msgs::VehicleStateArray& states);
   /// The decision on a decision step's state; `received` is when the state arrived (for
-  /// decision_ms). A malformed state is answered empty, not thrown.
-  RsuDecision decide(const palcas_msgs::VehicleStateArray& states, Clock::time_point received);
+  /// decision_ms). A malformed state is answered empty, not thrown. `used_densities` (with
+  /// I2I on): decide on these neighbours' densities instead of the peers' states received
+  /// (replay_policy: the ones a recording says the live RSU used); null = the peers'.
+  RsuDecision decide(const palcas_msgs::VehicleStateArray& states, Clock::time_point received,
+                     const GlobalDensities* used_densities = nullptr);
   /// What follows a sent decision (see the header comment); returns the decision's status.
   palcas_msgs::RsuStatus afterPublished(const palcas_msgs::VehicleStateArray& states, const RsuDecision& decision);
   /// An empty answer to a step (no advice: CAVs keep their commands).
