@@ -3,6 +3,8 @@
 #include <palcas_common/model_weights.h>
 #include <ros/console.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 
@@ -32,6 +34,43 @@ double msSince(RsuDecider::Clock::time_point t) {
 }
 
 }  // namespace
+
+void logFederationEvent(const std::string& who, FederationEvent event, const std::string& message) {
+  switch (event) {
+    case FederationEvent::kUnreachable:
+      ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s%s", who.c_str(), message.c_str());
+      break;
+    case FederationEvent::kModelRefused:
+      ROS_ERROR_THROTTLE_NAMED(10.0, "federation", "%s%s", who.c_str(), message.c_str());
+      break;
+    case FederationEvent::kSubmitRefused:
+      ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s%s", who.c_str(), message.c_str());
+      break;
+    case FederationEvent::kSubmitted:
+    case FederationEvent::kLoaded:
+      ROS_INFO_NAMED("federation", "%s%s", who.c_str(), message.c_str());
+      break;
+  }
+}
+
+std::string describeDecision(const RsuDecision& decision, std::uint32_t members) {
+  const palcas_msgs::AdvisoryArray& a = decision.advisories;
+  std::string advice;
+  for (const palcas_msgs::Advisory& adv : a.advisories) {
+    advice += " " + adv.vehicle_id + ":" + actionName(static_cast<Action>(adv.action));
+    if (static_cast<Action>(adv.action) == Action::kAccelerate) {
+      char accel[16];
+      std::snprintf(accel, sizeof accel, "(%+.2f)", adv.accel_mps2);
+      advice += accel;
+    }
+  }
+  char head[200];
+  std::snprintf(head, sizeof head, "%s: step %lu: %u members, density %.1f veh/km (I2I up %.1f, down %.1f), %.2f ms;",
+                a.rsu_id.c_str(), static_cast<unsigned long>(a.step), members,
+                decision.cluster_state ? decision.cluster_state->density_veh_per_km : std::nan(""),
+                a.i2i_upstream_density_veh_per_km, a.i2i_downstream_density_veh_per_km, a.decision_ms);
+  return head + advice;
+}
 
 RsuDecider::RsuDecider(RsuNodeOptions options)
     : options_(std::move(options)),
@@ -106,6 +145,10 @@ void RsuDecider::startFederation(std::unique_ptr<FederationTransport> transport,
         if (federation_log_) federation_log_(e, message);
       });
   if (server_reachable) federation_->join();
+}
+
+void RsuDecider::announceGlobalVersion(uint32_t version) {
+  if (federation_) federation_->announceVersion(version);
 }
 
 void RsuDecider::onEvents(const palcas_msgs::VehicleEventArray& events) { addOutcomes(events, outcomes_); }

@@ -1,5 +1,7 @@
 #include "palcas_rsu/rsu_diagnostics.h"
 
+#include "palcas_rsu/rsu_decider.h"
+
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
 #include <algorithm>
@@ -47,6 +49,18 @@ double RecentTimes::percentile(double p) const {
   const std::size_t k = std::min(v.size() - 1, rank > 0 ? rank - 1 : 0);
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return v[k];
+}
+
+void addChannelCounts(const RsuDecider& rsu, diagnostic_updater::DiagnosticStatusWrapper& s) {
+  const v2x::UplinkCounts* n = rsu.uplinkCounts();
+  if (!n) return;
+  s.add("V2X vehicle states sent", n->sent);
+  s.add("V2X vehicle states lost", n->lost);
+  s.add("V2X vehicle states out of range", n->out_of_range);
+  s.add("V2X vehicles forgotten (state too old)", n->forgotten);
+  s.add("V2X mean age of the states used [s]", n->used ? n->used_age_sum_s / static_cast<double>(n->used) : 0.0);
+  s.add("V2X cluster states lost", rsu.i2iLost());
+  s.add("V2X cluster states received", rsu.i2iReceived());
 }
 
 }  // namespace palcas::rsu

@@ -8,9 +8,8 @@
 #include <palcas_msgs/AdvisoryArray.h>
 #include <palcas_msgs/RegisterRsu.h>
 #include <palcas_msgs/RsuStatus.h>
+#include <std_msgs/UInt32.h>
 
-#include <cstdio>
-#include <cmath>
 
 #include "palcas_rsu/federation_transport.h"
 #include "palcas_rsu/msg_conversion.h"
@@ -87,8 +86,11 @@ void RsuNode::startFederation() {
              "will join when it answers", options_.controller.rsu_id.c_str(), options_.federation_wait_s);
   decider_->startFederation(
       std::make_unique<RosFederationTransport>(nh_, auth_key_.get(), submitted_pub_), reachable,
-      [this](FederationEvent e, const std::string& message) { onFederationEvent(e, message); },
+      [this](FederationEvent e, const std::string& message) { logFederationEvent("", e, message); },
       [this](const palcas_msgs::ModelWeights& model) { model_pub_.publish(model); });
+  // A waiting RSU fetches when the server says a newer model is there, not every decision.
+  version_sub_ = nh_.subscribe<std_msgs::UInt32>(
+      GLOBAL_MODEL_VERSION_TOPIC, 1, [this](const std_msgs::UInt32::ConstPtr& v) { decider_->announceGlobalVersion(v->data); });
 }
 
 void RsuNode::waitForPeers() {
@@ -251,29 +253,11 @@ void RsuNode::decide(const palcas_msgs::VehicleStateArray& msg, RsuDecider::Cloc
   if (decision.cluster_state) cluster_pub_.publish(*decision.cluster_state);
   publishAdvisories(decision.advisories);
   if (!decision.decided) return;
-  logDecisionDetail(decision);
+  ROS_DEBUG_NAMED("decision", "%s", describeDecision(decision, decider_->controller().stats().member_count).c_str());
   last_status_ = decider_->afterPublished(msg, decision);
   status_pub_.publish(last_status_);
   recent_decision_ms_.add(decision.advisories.decision_ms);
   diagnostics_.update();
-}
-
-void RsuNode::logDecisionDetail(const RsuDecision& decision) const {
-  const palcas_msgs::AdvisoryArray& a = decision.advisories;
-  std::string advice;
-  for (const palcas_msgs::Advisory& adv : a.advisories) {
-    advice += " " + adv.vehicle_id + ":" + actionName(static_cast<Action>(adv.action));
-    if (static_cast<Action>(adv.action) == Action::kAccelerate) {
-      char accel[16];
-      std::snprintf(accel, sizeof accel, "(%+.2f)", adv.accel_mps2);
-      advice += accel;
-    }
-  }
-  ROS_DEBUG_NAMED("decision", "%s: step %lu: %u members, density %.1f veh/km (I2I up %.1f, down %.1f), %.2f ms;%s",
-                  options_.controller.rsu_id.c_str(), static_cast<unsigned long>(a.step),
-                  decider_->controller().stats().member_count,
-                  decision.cluster_state ? decision.cluster_state->density_veh_per_km : std::nan(""),
-                  a.i2i_upstream_density_veh_per_km, a.i2i_downstream_density_veh_per_km, a.decision_ms, advice.c_str());
 }
 
 void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
@@ -290,30 +274,7 @@ void RsuNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s) {
   std::string down;
   for (int k : inputs_.presumedDown()) down += (down.empty() ? "" : " ") + std::to_string(k);
   s.add("neighbours presumed down (not waited for)", down.empty() ? "none" : down);
-  addChannelCounts(s);
-}
-
-void RsuNode::onFederationEvent(FederationEvent event, const std::string& message) {
-  // One log call per kind, so each kind is throttled on its own.
-  switch (event) {
-    case FederationEvent::kUnreachable: ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
-    case FederationEvent::kModelRefused: ROS_ERROR_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
-    case FederationEvent::kSubmitRefused: ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s", message.c_str()); break;
-    case FederationEvent::kSubmitted: ROS_INFO_NAMED("federation", "%s", message.c_str()); break;
-    case FederationEvent::kLoaded: ROS_INFO_NAMED("federation", "%s", message.c_str()); break;
-  }
-}
-
-void RsuNode::addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) const {
-  const v2x::UplinkCounts* n = decider_->uplinkCounts();
-  if (!n) return;
-  s.add("V2X vehicle states sent", n->sent);
-  s.add("V2X vehicle states lost", n->lost);
-  s.add("V2X vehicle states out of range", n->out_of_range);
-  s.add("V2X vehicles forgotten (state too old)", n->forgotten);
-  s.add("V2X mean age of the states used [s]", n->used ? n->used_age_sum_s / static_cast<double>(n->used) : 0.0);
-  s.add("V2X cluster states lost", decider_->i2iLost());
-  s.add("V2X cluster states received", decider_->i2iReceived());
+  addChannelCounts(*decider_, s);
 }
 
 void RsuNode::shutdown() {

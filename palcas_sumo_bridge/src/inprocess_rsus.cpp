@@ -6,32 +6,11 @@
 #include <palcas_rsu/federation_transport.h>
 #include <palcas_rsu/rsu_options.h>
 #include <palcas_rsu/topics.h>
+#include <std_msgs/UInt32.h>
 
 #include <stdexcept>
 
 namespace palcas::bridge {
-
-namespace {
-
-void logFederation(const std::string& rsu_id, FederationEvent event, const std::string& message) {
-  switch (event) {
-    case FederationEvent::kUnreachable:
-      ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s (in process): %s", rsu_id.c_str(), message.c_str());
-      break;
-    case FederationEvent::kModelRefused:
-      ROS_ERROR_THROTTLE_NAMED(10.0, "federation", "%s (in process): %s", rsu_id.c_str(), message.c_str());
-      break;
-    case FederationEvent::kSubmitRefused:
-      ROS_WARN_THROTTLE_NAMED(10.0, "federation", "%s (in process): %s", rsu_id.c_str(), message.c_str());
-      break;
-    case FederationEvent::kSubmitted:
-    case FederationEvent::kLoaded:
-      ROS_INFO_NAMED("federation", "%s (in process): %s", rsu_id.c_str(), message.c_str());
-      break;
-  }
-}
-
-}  // namespace
 
 InProcessRsus::InProcessRsus(ros::NodeHandle nh, const std::vector<std::string>& rsu_ids,
                              const std::vector<double>& zones_m, int num_lanes, const auth::MessageKey* key) {
@@ -65,7 +44,7 @@ InProcessRsus::InProcessRsus(ros::NodeHandle nh, const std::vector<std::string>&
       ros::Publisher model_pub = r.model_pub;
       r.decider->startFederation(
           std::make_unique<rsu::RosFederationTransport>(fedserver, key, r.submitted_pub), reachable,
-          [id](FederationEvent e, const std::string& message) { logFederation(id, e, message); },
+          [](FederationEvent e, const std::string& message) { rsu::logFederationEvent("in process: ", e, message); },
           [model_pub](const palcas_msgs::ModelWeights& m) { model_pub.publish(m); });
     }
     const rsu::RsuControllerOptions& c = r.decider->options().controller;
@@ -75,6 +54,12 @@ InProcessRsus::InProcessRsus(ros::NodeHandle nh, const std::vector<std::string>&
                    o.i2i ? "on" : "off");
     rsus_.push_back(std::move(r));
   }
+  // A waiting RSU fetches when the server says a newer model is there, not every decision
+  // (callbacks run in the bridge's receive(), every step).
+  version_sub_ = fedserver.subscribe<std_msgs::UInt32>(
+      rsu::GLOBAL_MODEL_VERSION_TOPIC, 1, [this](const std_msgs::UInt32::ConstPtr& v) {
+        for (Rsu& r : rsus_) r.decider->announceGlobalVersion(v->data);
+      });
 }
 
 std::vector<std::pair<std::string, int>> InProcessRsus::decisionPeriods() const {

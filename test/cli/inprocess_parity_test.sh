@@ -64,8 +64,6 @@ else:
     ta, tb = rows(a / "trajectories.csv", before_s=30), rows(b / "trajectories.csv", before_s=30)
     if len(ta) < 100: problems.append("the ROS training recorded only %d trajectory rows in its first 30 s" % len(ta))
     if ta != tb: problems.append("first 30 s of training trajectories (with each CAV's command) differ")
-    late = json.loads((a / "metrics.json").read_text()).get("late_rsu_steps", 0)
-    if late: problems.append("the ROS training had %s late RSU steps" % late)
     ma = mb = {}
 diff = sorted(k for k in set(ma) | set(mb) if ma.get(k) != mb.get(k))
 if diff: problems.append("metrics differ in %s" % ", ".join(diff[:8]))

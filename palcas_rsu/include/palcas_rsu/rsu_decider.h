@@ -54,6 +54,14 @@ struct RsuDecision {
   GlobalDensities from_peers;
 };
 
+/// Logs a federation client event on logger "federation", one call per kind so each kind
+/// is throttled on its own. The client's messages name the RSU; `who` goes before them
+/// ("" in the node, "in process: " in the bridge).
+void logFederationEvent(const std::string& who, FederationEvent event, const std::string& message);
+
+/// One decision in words (DEBUG on logger "decision"): members, densities, every advisory.
+std::string describeDecision(const RsuDecision& decision, std::uint32_t members);
+
 class RsuDecider {
  public:
   using Clock = std::chrono::steady_clock;
@@ -77,6 +85,9 @@ class RsuDecider {
   void startFederation(std::unique_ptr<FederationTransport> transport, bool server_reachable, FederationLog log,
                        ModelLoaded loaded);
 
+  /// The federation server announced its global model's version (its latched topic): a
+  /// waiting RSU fetches when told of a newer one instead of polling every decision.
+  void announceGlobalVersion(uint32_t version);
   /// A step's vehicle events (they close training transitions).
   void onEvents(const palcas_msgs::VehicleEventArray& events);
   /// A peer's cluster state (own ones are ignored), through the V2X channel when it is on.

@@ -24,6 +24,10 @@ struct RsuHealthFacts {
 /// decision (waiting for the bridge).
 void describeRsu(const RsuHealthFacts& f, diagnostic_updater::DiagnosticStatusWrapper& s);
 
+class RsuDecider;
+/// The V2X channel's counts of an RSU as /diagnostics key-values (nothing when it is off).
+void addChannelCounts(const RsuDecider& rsu, diagnostic_updater::DiagnosticStatusWrapper& s);
+
 /// The last `capacity` decision times and their nearest-rank percentile.
 class RecentTimes {
  public:

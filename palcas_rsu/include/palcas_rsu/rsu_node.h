@@ -49,21 +49,15 @@ class RsuNode {
   /// Decides the held state with what is there (the wait ran out, or a later state came):
   /// the neighbours still missing are presumed down; said once per wait.
   void decideHeldAnyway(const char* why);
-  /// DEBUG on logger "decision": every advisory of one decision.
-  void logDecisionDetail(const RsuDecision& decision) const;
   void answerEmpty(const palcas_msgs::VehicleStateArray& msg, RsuDecider::Clock::time_point received);
   void waitForPeers();
   void registerWithBridge();
   /// Starts the federation client over the fedserver's services (training with federation).
   void startFederation();
-  /// Logs what the federation client did.
-  void onFederationEvent(FederationEvent event, const std::string& message);
   /// Signs (with a key) and publishes one step's answer.
   void publishAdvisories(palcas_msgs::AdvisoryArray& out);
   /// /diagnostics "<rsu>: decisions" (rsu_diagnostics.h).
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& s);
-  /// The channel's counts as /diagnostics key-values (nothing when it is off).
-  void addChannelCounts(diagnostic_updater::DiagnosticStatusWrapper& s) const;
 
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<RsuDecider> decider_;
@@ -71,7 +65,7 @@ class RsuNode {
   std::unique_ptr<auth::MessageKey> auth_key_;  ///< null: nothing signed or checked
 
   ros::Publisher advisories_pub_, cluster_pub_, status_pub_, submitted_pub_, model_pub_;
-  ros::Subscriber states_sub_, events_sub_, cluster_sub_;
+  ros::Subscriber states_sub_, events_sub_, cluster_sub_, version_sub_;
 
   bool answer_decision_steps_only_ = false;  ///< registered with the bridge at our decision period
   DecisionInputs inputs_;

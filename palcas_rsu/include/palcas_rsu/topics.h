@@ -11,6 +11,7 @@ constexpr char ADVISORIES_TOPIC[] = "advisories";            // out: palcas_msgs
 constexpr char RSU_STATUS_TOPIC[] = "rsu_status";            // out: palcas_msgs/RsuStatus
 constexpr char SUBMITTED_WEIGHTS_TOPIC[] = "submitted_weights";  // out, latched: what it sent, once per round
 constexpr char MODEL_TOPIC[] = "model";                      // out, latched: the global model it loaded
+constexpr char GLOBAL_MODEL_VERSION_TOPIC[] = "global_model_version";  // in, latched: the server's global version
 constexpr char REGISTER_RSU_SERVICE[] = "register_rsu";      // client: palcas_msgs/RegisterRsu
 constexpr char SUBMIT_WEIGHTS_SERVICE[] = "submit_weights";  // client: palcas_msgs/SubmitWeights
 constexpr char FETCH_MODEL_SERVICE[] = "fetch_global_model"; // client: palcas_msgs/FetchGlobalModel

@@ -51,6 +51,7 @@ class InProcessRsus {
     ros::Publisher status_pub, cluster_pub, submitted_pub, model_pub;
   };
   std::vector<Rsu> rsus_;
+  ros::Subscriber version_sub_;  ///< the server's global version, announced to every RSU
 };
 
 }  // namespace palcas::bridge

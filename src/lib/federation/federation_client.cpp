@@ -1,5 +1,6 @@
 #include "palcas_core/federation/federation_client.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -95,11 +96,19 @@ void FederationClient::submit() {
   }
 }
 
+void FederationClient::announceVersion(uint32_t version) {
+  announced_ = true;
+  announced_version_ = std::max(announced_version_, version);
+}
+
 void FederationClient::onDecision(double now_s) {
   if (!std::isfinite(now_s)) throw std::invalid_argument("federation client: now_s is not finite");
   // The sim clock restarts with every episode: a call "in the future" is from the last one.
   if (last_call_s_ > now_s) last_call_s_ = now_s;
   if (submitted_) {  // waiting for the round to close: poll without blocking the advisories
+    const bool told_newer = announced_ && announced_version_ > model_.modelVersion();
+    const bool heartbeat_due = options_.heartbeat_s > 0 && now_s - last_call_s_ >= options_.heartbeat_s;
+    if (announced_ && !told_newer && !heartbeat_due) return;
     last_call_s_ = now_s;
     fetchGlobal(model_.modelVersion() + 1);
     return;

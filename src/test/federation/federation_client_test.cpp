@@ -181,6 +181,48 @@ TEST(FederationClient, ARoundSubmitsWaitsAndLoadsTheSampleWeightedAverage) {
   }
 }
 
+TEST(FederationClient, AnnouncedVersionsReplaceThePollWhileWaiting) {
+  Federation f(10.0);
+  for (auto& c : f.clients) c->join();
+  for (auto& c : f.clients) c->announceVersion(f.server->globalVersion());
+  f.now = 1.0;
+  f.models[0]->train({3, 3, 3}, 1);
+  f.clients[0]->onDecision(f.now);  // submits
+  ASSERT_TRUE(f.clients[0]->waiting());
+  const uint64_t after_submit = f.clients[0]->calls();
+  for (int t = 2; t <= 8; ++t) f.clients[0]->onDecision(t);  // nothing newer announced: no call
+  EXPECT_EQ(f.clients[0]->calls(), after_submit);
+  f.models[1]->train({6, 6, 6}, 2);
+  f.models[2]->train({0, 0, 0}, 3);
+  f.clients[1]->onDecision(f.now);
+  f.clients[2]->onDecision(f.now);  // closes the round
+  ASSERT_EQ(f.server->globalVersion(), 2u);
+  f.clients[0]->onDecision(9.0);  // the round closed, but nobody said so yet
+  EXPECT_TRUE(f.clients[0]->waiting());
+  f.clients[0]->announceVersion(2);
+  f.clients[0]->onDecision(9.5);  // told: one fetch loads it
+  EXPECT_EQ(f.clients[0]->calls(), after_submit + 1);
+  EXPECT_FALSE(f.clients[0]->waiting());
+  EXPECT_EQ(f.models[0]->modelVersion(), 2u);
+}
+
+TEST(FederationClient, AMissedAnnouncementIsCaughtByTheHeartbeat) {
+  Federation f(10.0);
+  for (auto& c : f.clients) c->join();
+  f.clients[0]->announceVersion(1);
+  for (size_t k = 0; k < 3; ++k) f.models[k]->train({1, 1, 1}, 1);
+  for (auto& c : f.clients) c->onDecision(1.0);  // all submit; the round closes
+  ASSERT_EQ(f.server->globalVersion(), 2u);
+  for (int t = 2; t <= 10; ++t) f.clients[0]->onDecision(t);  // no announcement: waits
+  EXPECT_TRUE(f.clients[0]->waiting());
+  f.clients[0]->onDecision(11.0);  // heartbeat_s after its last call: polls, and loads
+  EXPECT_FALSE(f.clients[0]->waiting());
+  EXPECT_EQ(f.models[0]->modelVersion(), 2u);
+  // Without any announcement a waiting client polls at every decision, as before.
+  f.clients[1]->onDecision(2.0);
+  EXPECT_FALSE(f.clients[1]->waiting());
+}
+
 TEST(FederationClient, HeartbeatsKeepAnRsuLiveBetweenRoundsAndFollowTheClockBack) {
   Federation f(10.0);
   f.clients[0]->join();

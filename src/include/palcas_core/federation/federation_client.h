@@ -6,7 +6,9 @@
 // seconds (sim time in the node), and nothing here blocks beyond the transport's calls.
 //
 // Round state machine, driven by onDecision(now_s) once per decision in train mode:
-//   training  -- federation due -->  submit -- accepted --> waiting (poll for the new version)
+//   training  -- federation due -->  submit -- accepted --> waiting (poll for the new version;
+//             once the server's announcements are heard, only when one names a newer version,
+//             and every heartbeat_s in case one was missed)
 //   waiting   -- new global model loaded --> training
 //   submit refused because the round moved on --> fetch that newer global model
 //   between rounds, every heartbeat_s: a fetch (keeps the RSU live at the server and picks
@@ -111,6 +113,11 @@ class FederationClient {
   /// One decision in train mode at sim time now_s: submit when due, poll while waiting,
   /// heartbeat between rounds. A sim clock that went back (a new episode) is followed.
   void onDecision(double now_s);
+  /// The server announced its global model's version (the node: the server's latched
+  /// version topic). From the first announcement on, a waiting client fetches only when an
+  /// announced version is newer than its model's (and every heartbeat_s, for a missed one)
+  /// instead of at every decision.
+  void announceVersion(uint32_t version);
 
   bool reachable() const { return reachable_; }
   /// The round open at the server as it last said.
@@ -134,6 +141,8 @@ class FederationClient {
   bool reachable_ = false;
   uint64_t calls_ = 0;
   double last_call_s_ = -1e300;  ///< sim time of the last call made by onDecision
+  bool announced_ = false;        ///< an announcement was heard
+  uint32_t announced_version_ = 0;
 };
 
 }  // namespace palcas
