@@ -136,9 +136,17 @@ bool BridgeNode::onRegister(palcas_msgs::RegisterRsu::Request& req,
 bool BridgeNode::waitForPeers() {
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration<double>(options_.startup_timeout_s);
+  // A registered RSU node subscribed before registering, but on the bridge's side its
+  // connection may still be opening, and a state published before it is up never reaches
+  // that RSU (with the V2X channel on, a missed early state changes what it hears at its
+  // first decision). So wait for the bridge's side too: one link per RSU node, plus
+  // min_subscribers (recorders, test nodes). In-process RSUs need no link.
+  auto subscribers_needed = [&] {
+    const std::size_t rsu_nodes = inprocess_ ? 0 : options_.expected_rsus.size() - runner_->lockstep().unregistered().size();
+    return static_cast<std::uint32_t>(options_.min_subscribers) + static_cast<std::uint32_t>(rsu_nodes);
+  };
   auto ready = [&] {
-    return runner_->lockstep().allRegistered() &&
-           states_pub_.getNumSubscribers() >= static_cast<std::uint32_t>(options_.min_subscribers);
+    return runner_->lockstep().allRegistered() && states_pub_.getNumSubscribers() >= subscribers_needed();
   };
   // Publish the clock so nodes on sim time can start; RSUs register once subscribed.
   rosgraph_msgs::Clock clock;
@@ -147,9 +155,9 @@ bool BridgeNode::waitForPeers() {
     clock_pub_.publish(clock);
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
   }
-  if (states_pub_.getNumSubscribers() < static_cast<std::uint32_t>(options_.min_subscribers))
-    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %d expected subscribers of %s after %.1f s",
-             states_pub_.getNumSubscribers(), options_.min_subscribers, VEHICLE_STATES_TOPIC,
+  if (states_pub_.getNumSubscribers() < subscribers_needed())
+    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
+             states_pub_.getNumSubscribers(), subscribers_needed(), VEHICLE_STATES_TOPIC,
              options_.startup_timeout_s);
   if (runner_->lockstep().allRegistered()) return true;
   std::string missing;
