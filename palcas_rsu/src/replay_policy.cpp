@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "palcas_rsu/msg_conversion.h"
+#include "palcas_rsu/replay_comparison.h"
 #include "palcas_rsu/rsu_decider.h"
 #include "palcas_rsu/rsu_options.h"
 
@@ -51,115 +52,18 @@ constexpr char ADVISORIES_TOPIC[] = "/advisories";
 constexpr char CLUSTER_TOPIC[] = "/cluster_states";
 constexpr char ROAD_TOPIC[] = "/road_description";
 
-/// Two ACCELERATE advisories agree when their accelerations differ by at most this [m/s^2].
-/// Both are float64 end to end, so an identical decision agrees exactly; the tolerance only
-/// absorbs a policy file rewritten with rounding, and is far below anything a CAV would feel.
-constexpr double DEFAULT_ACCEL_TOLERANCE = 1e-3;
-
 /// Bad input (not a bag, missing topics, no model, a model that does not fit): exit 1.
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-/// A bad command line: exit 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-struct Args {
-  std::string bag;
-  std::string policy;
-  std::string csv;
-  double accel_tolerance = DEFAULT_ACCEL_TOLERANCE;
-};
-
-const char* USAGE =
-    "usage: replay_policy BAG --policy DIR [--csv FILE] [--accel-tolerance MPS2]\n"
-    "  BAG      a bag recorded by ./palcas run --record (system.launch record:=true)\n"
-    "  DIR      a training's checkpoints/ folder, or a policy folder that contains checkpoints/\n"
-    "  FILE     every disagreement as CSV (default: BAG without .bag + .replay.csv)\n"
-    "  MPS2     ACCELERATE advisories agree within this [m/s^2] (default 0.001)\n"
-    "RSU parameters: from the parameter server under ~ (./palcas replay loads them).\n";
-
-Args parseArgs(const std::vector<std::string>& argv) {
-  Args a;
-  for (std::size_t i = 0; i < argv.size(); ++i) {
-    const std::string& s = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argv.size() || argv[i + 1].rfind("--", 0) == 0)
-        throw UsageError("option " + s + " needs a value");
-      return argv[++i];
-    };
-    if (s == "--policy") a.policy = value();
-    else if (s == "--csv") a.csv = value();
-    else if (s == "--accel-tolerance") {
-      const std::string v = value();
-      char* end = nullptr;
-      a.accel_tolerance = std::strtod(v.c_str(), &end);
-      if (v.empty() || *end != '\0' || !(a.accel_tolerance >= 0.0) || !std::isfinite(a.accel_tolerance))
-        throw UsageError("--accel-tolerance '" + v + "': expected a number >= 0");
-    } else if (s == "-h" || s == "--help") {
-      std::cout << USAGE;
-      std::exit(0);
-    } else if (s.rfind("--", 0) == 0) {
-      throw UsageError("unknown option '" + s + "'");
-    } else if (a.bag.empty()) {
-      a.bag = s;
-    } else {
-      throw UsageError("one bag only; '" + s + "' is a second");
-    }
-  }
-  if (a.bag.empty()) throw UsageError("no bag given");
-  if (a.policy.empty()) throw UsageError("--policy DIR is required");
-  if (a.csv.empty()) {
-    fs::path p(a.bag);
-    a.csv = (p.parent_path() / (p.stem().string() + ".replay.csv")).string();
-  }
-  return a;
-}
-
-const char* actionName(int action) {
-  switch (action) {
-    case palcas_msgs::Advisory::LANE_LEFT: return "LANE_LEFT";
-    case palcas_msgs::Advisory::LANE_RIGHT: return "LANE_RIGHT";
-    case palcas_msgs::Advisory::ACCELERATE: return "ACCELERATE";
-    case palcas_msgs::Advisory::KEEP: return "KEEP";
-    default: return "UNKNOWN";
-  }
-}
-
 /// Two I2I densities agree when both are unknown (NaN) or equal.
 bool sameDensity(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
-
-/// One advisory as recorded or replayed (action < 0: none for that vehicle).
-struct Advice {
-  int action = -1;
-  double accel_mps2 = 0.0;
-};
-
-std::string adviceText(const Advice& a) {
-  if (a.action < 0) return "none";
-  if (a.action != palcas_msgs::Advisory::ACCELERATE) return actionName(a.action);
-  char text[64];
-  std::snprintf(text, sizeof text, "ACCELERATE %+.4f", a.accel_mps2);
-  return text;
-}
 
 /// The road as the bag describes it.
 struct Road {
   std::vector<double> zones_m;
   int num_lanes = 0;
   std::string source;
-};
-
-/// Counts of agreement for one group (an RSU, a recorded action).
-struct Tally {
-  std::uint64_t compared = 0, agreed = 0;
-  std::string percent() const {
-    if (compared == 0) return "n/a";
-    char text[32];
-    std::snprintf(text, sizeof text, "%.2f %%", 100.0 * static_cast<double>(agreed) / static_cast<double>(compared));
-    return text;
-  }
 };
 
 /// DIR is a training's checkpoints/ folder or a policy folder containing checkpoints/.
@@ -227,10 +131,9 @@ struct ReplayedRsu {
   /// uplink, I2I bookkeeping and controller call as the live RSU.
   std::unique_ptr<palcas::rsu::RsuDecider> decider;
   fs::path model;
-  Tally tally;
 };
 
-int run(const Args& args) {
+int run(const palcas::rsu::ReplayArgs& args) {
   if (!fs::is_regular_file(args.bag)) throw InputError("'" + args.bag + "': no such file");
   rosbag::Bag bag;
   try {
@@ -359,7 +262,7 @@ int run(const Args& args) {
 
   std::ofstream csv(args.csv);
   if (!csv) throw InputError("cannot write the CSV '" + args.csv + "'");
-  csv << "step,time_s,rsu,vehicle,recorded_action,recorded_accel_mps2,replayed_action,replayed_accel_mps2\n";
+  csv << palcas::rsu::ReplayComparison::CSV_HEADER << "\n";
 
   std::printf("replay: %s\n  road: %zu zone(s), %d lanes (state size %d) from %s; decision every %d steps; I2I %s%s\n",
               args.bag.c_str(), road.zones_m.size() - 1, road.num_lanes, state_size, road.source.c_str(), period,
@@ -368,12 +271,9 @@ int run(const Args& args) {
     std::printf("  %s [%.0f, %.0f) m: %s\n", r.id.c_str(), r.decider->options().controller.x_start_m,
                 r.decider->options().controller.x_end_m, r.model.c_str());
 
-  std::map<int, Tally> by_action;  // key: recorded action, -1 = the recording advised nothing
-  Tally total;
+  palcas::rsu::ReplayComparison comparison(args.accel_tolerance);
   std::uint64_t decisions_unrecorded = 0, decision_steps = 0, not_decided = 0;
   std::set<std::pair<std::uint64_t, std::string>> answered;  // recorded (step, rsu) the replay reached
-  bool diverged = false;
-  std::string first_divergence;
   std::size_t next_cluster_state = 0;
   std::uint64_t i2i_delivered_otherwise = 0;  // decisions whose live peer states differ from the bag's order
 
@@ -423,45 +323,13 @@ int run(const Args& args) {
       if (used && (!sameDensity(d.from_peers.upstream, used->upstream) ||
                    !sameDensity(d.from_peers.downstream, used->downstream)))
         ++i2i_delivered_otherwise;
-      std::map<std::string, Advice> replayed;
       if (!d.decided) ++not_decided;  // the live RSU answered empty too
-      for (const palcas_msgs::Advisory& a : d.advisories.advisories)
-        replayed[a.vehicle_id] = Advice{a.action, a.accel_mps2};
       if (rec == recorded.end()) {
-        decisions_unrecorded += replayed.size();
+        decisions_unrecorded += d.advisories.advisories.size();
         continue;
       }
       answered.insert(key);
-      std::map<std::string, Advice> said;
-      for (const auto& a : rec->second.advisories) said[a.vehicle_id] = Advice{a.action, a.accel_mps2};
-      std::set<std::string> vehicles;
-      for (const auto& [v, _] : said) vehicles.insert(v);
-      for (const auto& [v, _] : replayed) vehicles.insert(v);
-      for (const std::string& v : vehicles) {
-        const Advice was = said.count(v) ? said[v] : Advice{};
-        const Advice now = replayed.count(v) ? replayed[v] : Advice{};
-        const bool agree = was.action == now.action &&
-                           (was.action != palcas_msgs::Advisory::ACCELERATE ||
-                            std::abs(was.accel_mps2 - now.accel_mps2) <= args.accel_tolerance);
-        for (Tally* t : {&total, &r.tally, &by_action[was.action]}) {
-          ++t->compared;
-          if (agree) ++t->agreed;
-        }
-        if (agree) continue;
-        char row[512];
-        std::snprintf(row, sizeof row, "%lu,%.3f,%s,%s,%s,%.6f,%s,%.6f\n", static_cast<unsigned long>(states->step),
-                      now_s, r.id.c_str(), v.c_str(), was.action < 0 ? "none" : actionName(was.action),
-                      was.accel_mps2, now.action < 0 ? "none" : actionName(now.action), now.accel_mps2);
-        csv << row;
-        if (!diverged) {
-          diverged = true;
-          char text[512];
-          std::snprintf(text, sizeof text, "step %lu (t = %.1f s), %s, vehicle %s: recorded %s, replayed %s",
-                        static_cast<unsigned long>(states->step), now_s, r.id.c_str(), v.c_str(),
-                        adviceText(was).c_str(), adviceText(now).c_str());
-          first_divergence = text;
-        }
-      }
+      comparison.compare(states->step, now_s, r.id, rec->second, d.advisories);
     }
   }
   // Recorded decisions whose vehicle states the bag lost: nothing to replay them from.
@@ -470,19 +338,25 @@ int run(const Args& args) {
     if (!array.advisories.empty() && key.first % static_cast<std::uint64_t>(period) == 0 && !answered.count(key))
       recorded_without_states += array.advisories.size();
 
+  for (const std::string& row : comparison.disagreementRows()) csv << row << "\n";
+  const palcas::rsu::Agreement& total = comparison.total();
   std::printf("decisions compared: %lu, agreement: %s\n", static_cast<unsigned long>(total.compared),
               total.percent().c_str());
-  for (const ReplayedRsu& r : rsus)
-    std::printf("  %s: %lu compared, agreement %s\n", r.id.c_str(), static_cast<unsigned long>(r.tally.compared),
-                r.tally.percent().c_str());
-  for (int action : {0, 1, 2, 3, -1}) {
-    const auto it = by_action.find(action);
-    if (it == by_action.end() && action < 0) continue;
-    const Tally t = it == by_action.end() ? Tally{} : it->second;
-    std::printf("  recorded %s: %lu compared, agreement %s\n", action < 0 ? "none" : actionName(action),
-                static_cast<unsigned long>(t.compared), t.percent().c_str());
+  for (const ReplayedRsu& r : rsus) {
+    const auto it = comparison.byRsu().find(r.id);
+    const palcas::rsu::Agreement a = it == comparison.byRsu().end() ? palcas::rsu::Agreement{} : it->second;
+    std::printf("  %s: %lu compared, agreement %s\n", r.id.c_str(), static_cast<unsigned long>(a.compared),
+                a.percent().c_str());
   }
-  std::printf("first divergence: %s\n", diverged ? first_divergence.c_str() : "none");
+  for (int action : {0, 1, 2, 3, -1}) {
+    const auto it = comparison.byRecordedAction().find(action);
+    if (it == comparison.byRecordedAction().end() && action < 0) continue;
+    const palcas::rsu::Agreement a = it == comparison.byRecordedAction().end() ? palcas::rsu::Agreement{} : it->second;
+    std::printf("  recorded %s: %lu compared, agreement %s\n", palcas::rsu::replayActionName(action),
+                static_cast<unsigned long>(a.compared), a.percent().c_str());
+  }
+  std::printf("first divergence: %s\n",
+              comparison.firstDivergence().empty() ? "none" : comparison.firstDivergence().c_str());
   std::printf("disagreements: %lu -> %s\n", static_cast<unsigned long>(total.compared - total.agreed),
               args.csv.c_str());
   std::printf("decision steps in the bag: %lu; not compared: %lu replayed advisories without a recorded answer, "
@@ -504,12 +378,16 @@ int main(int argc, char** argv) {
   std::vector<std::string> rest;
   ros::removeROSArgs(argc, argv, rest);
   rest.erase(rest.begin());
-  Args args;
+  palcas::rsu::ReplayArgs args;
   try {
-    args = parseArgs(rest);
-  } catch (const UsageError& e) {
-    std::cerr << "replay_policy: " << e.what() << "\n" << USAGE;
+    args = palcas::rsu::parseReplayArgs(rest);
+  } catch (const palcas::rsu::ReplayUsageError& e) {
+    std::cerr << "replay_policy: " << e.what() << "\n" << palcas::rsu::REPLAY_USAGE;
     return 2;
+  }
+  if (args.help) {
+    std::cout << palcas::rsu::REPLAY_USAGE;
+    return 0;
   }
   if (!ros::master::check()) {
     std::cerr << "replay_policy: no ROS master at " << ros::master::getURI()
