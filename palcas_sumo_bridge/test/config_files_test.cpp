@@ -31,7 +31,7 @@ TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   EXPECT_TRUE(o.session.own_merge);
   EXPECT_DOUBLE_EQ(o.session.max_advised_accel_mps2, 1.47);  // departure; paper: 0 (no clip)
   // Departure, on by default: a busy zone's own lane changes accelerate at most at a_th.
-  EXPECT_DOUBLE_EQ(o.session.guard_busy_change_max_accel_mps2, o.comfort_threshold_mps2);
+  EXPECT_DOUBLE_EQ(o.session.guard.busy_change_max_accel_mps2, o.comfort_threshold_mps2);
   EXPECT_EQ(o.trajectory_period_steps, 0);
   EXPECT_TRUE(o.session.remove_collided);
   EXPECT_EQ(o.out_dir, "/tmp/palcas_config_test");
