@@ -103,6 +103,17 @@ TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
   refused("~out_of_range", "penetration_rate");          // a penetration rate of 1.2
   refused("~bad_guard", "guard_floor_speed_share");      // a guard floor of 1.5 x allowed speed
   refused("~bad_busy_change", "guard_busy_change_max_accel_mps2");  // a negative accel bound
+  refused("~bad_guard_enabled", "guard_enabled");        // a string master switch
+}
+
+TEST(ConfigFiles, TheGuardsMasterSwitchLeavesItsKeysAsTheyAre) {
+  const auto on = loadBridgeOptions(ros::NodeHandle("~paper"));
+  EXPECT_TRUE(on.session.guard.enabled);
+  const auto off = loadBridgeOptions(ros::NodeHandle("~guard_off"));
+  EXPECT_FALSE(off.session.guard.enabled);
+  EXPECT_DOUBLE_EQ(off.session.guard.floor_speed_share, on.session.guard.floor_speed_share);
+  EXPECT_DOUBLE_EQ(off.session.guard.busy_speed_share, on.session.guard.busy_speed_share);
+  EXPECT_EQ(off.session.guard.insertion_edge, on.session.guard.insertion_edge);
 }
 
 int main(int argc, char** argv) {
