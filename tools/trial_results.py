@@ -255,10 +255,11 @@ def mechanism_rows(arms, registry, settings):
                yes(entry.get("federation")), yes(entry.get("i2i")), yes(entry.get("advisory_control")),
                yes(entry.get("assist_mode"))]
         if entry.get("advisory_control"):
-            lc = number(params.get("guard_busy_lc_assertive")) or 0.0
-            row += ["on" if params.get("guard_busy_handback") else "off",
+            guard_on = params.get("guard_enabled", True) is not False  # false: no guard rule acts
+            lc = (number(params.get("guard_busy_lc_assertive")) or 0.0) if guard_on else 0.0
+            row += ["on" if guard_on and params.get("guard_busy_handback") else "off",
                     f"lcAssertive {lc:.1f}" if lc > 0 else "off",
-                    accel_text(params.get("guard_busy_change_max_accel_mps2")),
+                    accel_text(params.get("guard_busy_change_max_accel_mps2") if guard_on else 0.0),
                     accel_text(params.get("lane_change_max_accel_mps2"))]
         else:
             row += ["—"] * 4

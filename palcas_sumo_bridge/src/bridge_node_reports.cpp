@@ -59,11 +59,11 @@ void BridgeNode::diagnoseGuard(diagnostic_updater::DiagnosticStatusWrapper& s) {
   const sim::GuardCounters& g = session().guardCounters();
   GuardFacts f;
   f.advisory_control = o.advisory_control;
-  f.busy_zones_on = o.guard_busy_speed_share > 0.0;
+  f.busy_zones_on = o.guard.enabled && o.guard.busy_speed_share > 0.0;
   f.zones = static_cast<int>(session().road().clusters().size());
   for (int k = 0; k < f.zones; ++k)
     if (session().zoneBusy(k)) f.busy_zones.push_back(k);
-  for (const sim::VehicleRecord& v : session().vehicles()) f.handed_back_now += v.handed_back ? 1 : 0;
+  for (const sim::VehicleRecord& v : session().vehicles()) f.handed_back_now += v.guard.handed_back ? 1 : 0;
   f.handbacks = g.handbacks;
   f.advice_dropped = g.handback_advice_dropped;
   f.lane_changes_busy_refused = g.lane_changes_busy_refused;

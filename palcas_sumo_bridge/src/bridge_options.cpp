@@ -81,6 +81,15 @@ sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::Node
 
 }  // namespace
 
+sim::GuardOptions loadGuardOptions(common::ParamReader& p) {
+  sim::GuardOptions g;
+  forEachGuardKey(g, [&p](const char* key, auto& value, auto... range) {
+    if constexpr (sizeof...(range) == 0) value = p.get<bool>(key, value);
+    else value = p.number(key, value, range...);
+  });
+  return g;
+}
+
 BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::ParamDefaults* defaults) {
   palcas::common::ParamReader p(private_nh, defaults);
   BridgeOptions o;
@@ -117,26 +126,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
       p.number("lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2, 0.0, 20.0);
   o.session.lane_change_max_decel_mps2 =
       p.number("lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2, 0.0, 20.0);
-  o.session.guard_floor_speed_share =
-      p.number("guard_floor_speed_share", o.session.guard_floor_speed_share, 0.0, 1.0);
-  o.session.guard_lane_change_cooldown_s =
-      p.number("guard_lane_change_cooldown_s", o.session.guard_lane_change_cooldown_s, 0.0, 3600.0);
-  o.session.guard_busy_speed_share =
-      p.number("guard_busy_speed_share", o.session.guard_busy_speed_share, 0.0, 1.0);
-  o.session.guard_busy_leave_share =
-      p.number("guard_busy_leave_share", o.session.guard_busy_leave_share, 0.0, 1.0);
-  o.session.guard_busy_window_s = p.number("guard_busy_window_s", o.session.guard_busy_window_s, 0.1, 3600.0);
-  o.session.guard_busy_at_start = p.get<bool>("guard_busy_at_start", o.session.guard_busy_at_start);
-  o.session.guard_busy_floor_speed_share =
-      p.number("guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share, 0.0, 1.0);
-  o.session.guard_busy_handback = p.get<bool>("guard_busy_handback", o.session.guard_busy_handback);
-  o.session.guard_busy_lc_assertive =
-      p.number("guard_busy_lc_assertive", o.session.guard_busy_lc_assertive, 0.0, 100.0);
-  o.session.guard_busy_change_max_accel_mps2 = p.number(
-      "guard_busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2, 0.0, 20.0);
-  o.session.guard_busy_change_hold_s =
-      p.number("guard_busy_change_hold_s", o.session.guard_busy_change_hold_s, 0.0, 600.0);
-  o.session.guard_insertion_edge = p.get<bool>("guard_insertion_edge", o.session.guard_insertion_edge);
+  o.session.guard = loadGuardOptions(p);
   o.session.assist_mode = p.get<bool>("assist_mode", o.session.assist_mode);
   o.session.assist_lane_change_mode =
       p.integer("assist_lane_change_mode", o.session.assist_lane_change_mode, 0, 4095);

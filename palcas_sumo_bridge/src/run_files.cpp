@@ -107,7 +107,7 @@ json scenarioJson(const sim::ScenarioConfig& c) {
 }
 
 json bridgeJson(const BridgeOptions& o) {
-  return {{"advisory_control", o.session.advisory_control},
+  json out = {{"advisory_control", o.session.advisory_control},
           {"cav_speed_mode", o.session.cav_speed_mode},
           {"cav_lane_change_mode", o.session.cav_lane_change_mode},
           {"lane_change_duration_s", o.session.lane_change_duration_s},
@@ -116,18 +116,6 @@ json bridgeJson(const BridgeOptions& o) {
           {"max_advised_accel_mps2", o.session.max_advised_accel_mps2},
           {"lane_change_max_accel_mps2", o.session.lane_change_max_accel_mps2},
           {"lane_change_max_decel_mps2", o.session.lane_change_max_decel_mps2},
-          {"guard_floor_speed_share", o.session.guard_floor_speed_share},
-          {"guard_lane_change_cooldown_s", o.session.guard_lane_change_cooldown_s},
-          {"guard_busy_speed_share", o.session.guard_busy_speed_share},
-          {"guard_busy_leave_share", o.session.guard_busy_leave_share},
-          {"guard_busy_window_s", o.session.guard_busy_window_s},
-          {"guard_busy_at_start", o.session.guard_busy_at_start},
-          {"guard_busy_floor_speed_share", o.session.guard_busy_floor_speed_share},
-          {"guard_busy_handback", o.session.guard_busy_handback},
-          {"guard_busy_lc_assertive", o.session.guard_busy_lc_assertive},
-          {"guard_busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2},
-          {"guard_busy_change_hold_s", o.session.guard_busy_change_hold_s},
-          {"guard_insertion_edge", o.session.guard_insertion_edge},
           {"assist_mode", o.session.assist_mode},
           {"assist_lane_change_mode", o.session.assist_lane_change_mode},
           {"cav_max_accel_mps2", o.session.cav_max_accel_mps2},
@@ -147,6 +135,8 @@ json bridgeJson(const BridgeOptions& o) {
           {"comfort_threshold_mps2", o.comfort_threshold_mps2},
           {"gui", o.gui},
           {"sumo_warnings", o.sumo_warnings}};
+  forEachGuardKey(o.session.guard, [&out](const char* key, const auto& value, auto...) { out[key] = value; });
+  return out;
 }
 
 // Runs of one command on one traffic agree to the last digit only where these agree.
@@ -264,7 +254,8 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
 json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
   const double dt = o.scenario.step_length_s;
   auto share = [](std::uint64_t part, std::uint64_t whole) { return whole ? number(100.0 * part / whole) : json(nullptr); };
-  return {{"floor_speed_share", o.session.guard_floor_speed_share},
+  return {{"enabled", o.session.guard.enabled},
+          {"floor_speed_share", o.session.guard.floor_speed_share},
           {"accelerate_cav_s", dt * g.accelerate_steps},
           {"accelerate_floored_cav_s", dt * g.accelerate_floored_steps},
           {"accelerate_released_cav_s", dt * g.accelerate_released_steps},
@@ -272,20 +263,20 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"lane_change_cav_s", dt * g.lane_change_steps},
           {"lane_change_released_cav_s", dt * g.lane_change_released_steps},
           {"lane_change_guarded_pct", share(g.lane_change_released_steps, g.lane_change_steps)},
-          {"lane_change_cooldown_s", o.session.guard_lane_change_cooldown_s},
+          {"lane_change_cooldown_s", o.session.guard.lane_change_cooldown_s},
           {"lane_changes_advised", g.lane_changes_advised},
           {"lane_changes_cooled_down", g.lane_changes_cooled_down},
-          {"busy_speed_share", o.session.guard_busy_speed_share},
-          {"busy_at_start", o.session.guard_busy_at_start},
+          {"busy_speed_share", o.session.guard.busy_speed_share},
+          {"busy_at_start", o.session.guard.busy_at_start},
           {"lane_changes_busy_refused", g.lane_changes_busy_refused},
           {"busy_zone_pct", share(g.busy_zone_steps, g.zone_steps)},
           {"busy_zone_s", o.scenario.step_length_s * g.busy_zone_steps},
-          {"handback", o.session.guard_busy_handback},
+          {"handback", o.session.guard.busy_handback},
           {"handbacks", g.handbacks},
           {"handback_cav_s", dt * g.handback_steps},
           {"handback_advice_dropped", g.handback_advice_dropped},
-          {"busy_lc_assertive", o.session.guard_busy_lc_assertive},
-          {"busy_change_max_accel_mps2", o.session.guard_busy_change_max_accel_mps2},
+          {"busy_lc_assertive", o.session.guard.busy_lc_assertive},
+          {"busy_change_max_accel_mps2", o.session.guard.busy_change_max_accel_mps2},
           {"busy_change_bounds", g.busy_change_bounds},
           {"busy_change_bound_cav_s", dt * g.busy_change_bound_steps},
           {"collided_cavs", g.collided_cavs},
@@ -293,7 +284,7 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"collided_busy_change_bounded", g.collided_busy_change_bounded},
           {"collided_advised_change", g.collided_advised_change},
           {"collided_accelerate", g.collided_accelerate},
-          {"insertion_edge", o.session.guard_insertion_edge},
+          {"insertion_edge", o.session.guard.insertion_edge},
           {"lane_changes_insertion_refused", g.lane_changes_insertion_refused}};
 }
 

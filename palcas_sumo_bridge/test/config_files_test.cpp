@@ -31,7 +31,7 @@ TEST(ConfigFiles, PaperScenarioAndBridgeDefaultsLoad) {
   EXPECT_TRUE(o.session.own_merge);
   EXPECT_DOUBLE_EQ(o.session.max_advised_accel_mps2, 1.47);  // departure; paper: 0 (no clip)
   // Departure, on by default: a busy zone's own lane changes accelerate at most at a_th.
-  EXPECT_DOUBLE_EQ(o.session.guard_busy_change_max_accel_mps2, o.comfort_threshold_mps2);
+  EXPECT_DOUBLE_EQ(o.session.guard.busy_change_max_accel_mps2, o.comfort_threshold_mps2);
   EXPECT_EQ(o.trajectory_period_steps, 0);
   EXPECT_TRUE(o.session.remove_collided);
   EXPECT_EQ(o.out_dir, "/tmp/palcas_config_test");
@@ -103,6 +103,17 @@ TEST(ConfigFiles, WrongTypeAndOutOfRangeAreNamed) {
   refused("~out_of_range", "penetration_rate");          // a penetration rate of 1.2
   refused("~bad_guard", "guard_floor_speed_share");      // a guard floor of 1.5 x allowed speed
   refused("~bad_busy_change", "guard_busy_change_max_accel_mps2");  // a negative accel bound
+  refused("~bad_guard_enabled", "guard_enabled");        // a string master switch
+}
+
+TEST(ConfigFiles, TheGuardsMasterSwitchLeavesItsKeysAsTheyAre) {
+  const auto on = loadBridgeOptions(ros::NodeHandle("~paper"));
+  EXPECT_TRUE(on.session.guard.enabled);
+  const auto off = loadBridgeOptions(ros::NodeHandle("~guard_off"));
+  EXPECT_FALSE(off.session.guard.enabled);
+  EXPECT_DOUBLE_EQ(off.session.guard.floor_speed_share, on.session.guard.floor_speed_share);
+  EXPECT_DOUBLE_EQ(off.session.guard.busy_speed_share, on.session.guard.busy_speed_share);
+  EXPECT_EQ(off.session.guard.insertion_edge, on.session.guard.insertion_edge);
 }
 
 int main(int argc, char** argv) {

@@ -70,7 +70,7 @@ TEST(MsgConversion, VehicleRecordToStateKeepsEveryField) {
   EXPECT_EQ(s.exit_cluster, 2);
   EXPECT_FALSE(s.driving_itself);
   palcas::sim::VehicleRecord busy = rampCav();
-  busy.handed_back = true;  // the guard handed it back: the RSUs must see it
+  busy.guard.handed_back = true;  // the guard handed it back: the RSUs must see it
   EXPECT_TRUE(toMsg(busy).driving_itself);
 }
 

@@ -50,13 +50,13 @@ if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameter
 why=""
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas paper_printed:=true out_dir:=/tmp/unused 2>&1)"
 for expected in 'own_car_following: false' 'own_merge: false' 'max_advised_accel_mps2: 0.0' \
-                'lane_change_max_accel_mps2: 0.0' 'cav_lane_change_mode: 256' 'guard_floor_speed_share: 0.0' \
-                'guard_busy_speed_share: 0.0'; do
+                'lane_change_max_accel_mps2: 0.0' 'cav_lane_change_mode: 256' 'guard_enabled: false'; do
   grep -q "^/palcas_sumo_bridge/$expected\$" <<<"$params" || why="$why paper_printed lacks '$expected';"
 done
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas policy_bridge_params:=none out_dir:=/tmp/unused 2>&1)"
 grep -q '^/palcas_sumo_bridge/lane_change_max_accel_mps2: 0.0$' <<<"$params" || why="$why the default is not config/bridge.yaml's 0.0;"
 grep -q '^/palcas_sumo_bridge/guard_floor_speed_share: 0.6$' <<<"$params" || why="$why the advice guard is not on by default (0.6);"
+grep -q '^/palcas_sumo_bridge/guard_enabled: true$' <<<"$params" || why="$why the advice guard is not enabled by default;"
 printf 'lane_change_max_accel_mps2: 2.0\nlane_change_duration_s: 3.0\n' >/tmp/palcas_policy_bridge_$$.yaml
 printf 'lane_change_duration_s: 2.5\n' >/tmp/palcas_user_bridge_$$.yaml
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused \

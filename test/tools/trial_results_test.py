@@ -213,6 +213,16 @@ class MechanismTest(unittest.TestCase):
         self.assertEqual(rows["palcas"]["advice"], "learned network")
         self.assertIn("policies/palcas/bridge.yaml", rows["palcas"]["bridge files over config/bridge.yaml"])
 
+    def test_a_guard_turned_off_shows_its_columns_off(self):
+        import yaml
+        from unittest import mock
+        registry = trial_results.load_registry()
+        arm = next(a for a, e in registry.items() if e["advisory_control"])
+        params = dict(yaml.safe_load((ROOT / "config" / "bridge.yaml").read_text()), guard_enabled=False)
+        with mock.patch.object(trial_results, "bridge_params", return_value=(params, [])):
+            row = dict(zip(trial_results.MECHANISM_HEAD, trial_results.mechanism_rows([arm], registry, {})[0]))
+        self.assertEqual([row[k] for k in trial_results.MECHANISM_HEAD[8:11]], ["off"] * 3)
+
     def test_advice_is_the_field_else_inferred_from_the_rsus(self):
         self.assertEqual(trial_results.advice_of({"rsus": "zones"}), "network")
         self.assertEqual(trial_results.advice_of({"rsus": "none"}), "none")

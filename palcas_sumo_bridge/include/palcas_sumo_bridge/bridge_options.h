@@ -15,6 +15,31 @@
 
 namespace palcas::bridge {
 
+/// The advice guard's keys guard_* (config/bridge.yaml documents each) with their field of
+/// sim::GuardOptions: f(key, flag) for a bool, f(key, number, min, max) for a number in
+/// [min, max]. The loader and the run's bridge parameters both walk it, so a new guard
+/// option is a field, a line here and its key in config/bridge.yaml.
+template <class GuardOptionsT, class F>
+void forEachGuardKey(GuardOptionsT& g, F&& f) {
+  f("guard_enabled", g.enabled);
+  f("guard_floor_speed_share", g.floor_speed_share, 0.0, 1.0);
+  f("guard_lane_change_cooldown_s", g.lane_change_cooldown_s, 0.0, 3600.0);
+  f("guard_busy_speed_share", g.busy_speed_share, 0.0, 1.0);
+  f("guard_busy_leave_share", g.busy_leave_share, 0.0, 1.0);
+  f("guard_busy_window_s", g.busy_window_s, 0.1, 3600.0);
+  f("guard_busy_at_start", g.busy_at_start);
+  f("guard_busy_floor_speed_share", g.busy_floor_speed_share, 0.0, 1.0);
+  f("guard_busy_handback", g.busy_handback);
+  f("guard_busy_lc_assertive", g.busy_lc_assertive, 0.0, 100.0);
+  f("guard_busy_change_max_accel_mps2", g.busy_change_max_accel_mps2, 0.0, 20.0);
+  f("guard_busy_change_hold_s", g.busy_change_hold_s, 0.0, 600.0);
+  f("guard_insertion_edge", g.insertion_edge);
+}
+
+/// The advice guard's options from the keys guard_* (forEachGuardKey).
+/// @throws std::invalid_argument naming a key of the wrong type or out of its range.
+sim::GuardOptions loadGuardOptions(common::ParamReader& p);
+
 struct BridgeOptions {
   // Scenario and run: ~scenario/* (config/scenarios/<name>/scenario.yaml) holds the road's
   // demand, PR, seed, duration and cluster length; ~scenario_dir overrides its folder.

@@ -3,6 +3,7 @@
 #include "palcas_sim/own_road.h"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <stdexcept>
 
@@ -149,6 +150,15 @@ const EdgeInfo& RoadLayout::edge(const std::string& id) const {
 int RoadLayout::clusterAt(double x_m) const {
   const int k = static_cast<int>(std::floor(x_m / cluster_length_m_));
   return std::clamp(k, 0, static_cast<int>(clusters_.size()) - 1);
+}
+
+int RoadLayout::zoneAt(double x_m) const {
+  if (clusters_.empty() || !(x_m >= clusters_.front().x_start_m) || !(x_m < clusters_.back().x_end_m)) return -1;
+  // The zones follow each other along x: the last one starting at or before x.
+  const auto after = std::upper_bound(clusters_.begin(), clusters_.end(), x_m,
+                                      [](double x, const ClusterInfo& c) { return x < c.x_start_m; });
+  const ClusterInfo& c = *std::prev(after);
+  return x_m < c.x_end_m ? c.index : -1;
 }
 
 int RoadLayout::paperLane(const std::string& edge_id, int sumo_lane_index) const {

@@ -1,6 +1,6 @@
 // SumoSession: start and stop SUMO, read the network, advance one step. The other concerns
-// are in sumo_session_vehicles.cpp (vehicle table), sumo_session_guard.cpp (zones and the
-// advice guard), sumo_session_routes.cpp (exit routing), sumo_session_actuation.cpp (advice
+// are in sumo_session_vehicles.cpp (vehicle table), sumo_session_guard.cpp (the advice
+// guard's decisions, palcas_sim/advice_guard.h, carried out), sumo_session_routes.cpp (exit routing), sumo_session_actuation.cpp (advice
 // carried out); sumo_session_api.h: the SUMO API they share (libsumo or libtraci).
 
 #include <algorithm>
@@ -27,7 +27,7 @@ const char* SumoSession::apiName() {
 #endif
 }
 
-SumoSession::SumoSession(const SessionOptions& options) : options_(options) {
+SumoSession::SumoSession(const SessionOptions& options) : options_(options), guard_(options.guard) {
   std::vector<std::string> cmd{options_.sumo_binary};
 #ifndef PALCAS_USE_LIBTRACI
   cmd[0] = "sumo";  // in-process: the binary name is only argv[0]
@@ -219,7 +219,7 @@ const StepEvents& SumoSession::step() {
     }
   }
   for (const std::string& id : events_.collided)
-    if (const VehicleRecord* v = find(id)) countCollidedUnderGuard(*v, &guard_);
+    if (const VehicleRecord* v = find(id)) countCollidedUnderGuard(*v, &guard_.counters());
   // Colliding vehicles are removed (by SUMO or above) and may also be listed as arrived,
   // now or in the next step; each leaves once, and only vehicles still tracked arrive.
   for (const std::string& id : events_.collided) removeVehicle(id, &events_.removed);

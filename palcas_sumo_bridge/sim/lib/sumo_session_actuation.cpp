@@ -1,6 +1,6 @@
 // SumoSession: carrying advice out: advised lane changes (requested, continued across
-// junctions, their acceleration bounded), held ACCELERATE / KEEP commands, and the guard's
-// refusals at the moment advice arrives.
+// junctions, their acceleration bounded), held ACCELERATE / KEEP commands, as the advice
+// guard (advice_guard.h) allows.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -68,7 +68,7 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
   if (v.lane == v.lane_change_target || time_s_ >= v.lane_change_until_s - 1e-9) {
     // Done, or dropped after lane_change_duration_s (no safe gap found in time).
     ++(v.lane == v.lane_change_target ? lane_changes_done_ : lane_changes_dropped_);
-    if (v.lane == v.lane_change_target) v.last_lane_change_s = time_s_;
+    if (v.lane == v.lane_change_target) AdviceGuard::laneChangeMade(v.guard, time_s_);
     v.lane_change_target = 0;
     restoreLaneChangeAcceleration(v);
     return;
@@ -79,14 +79,9 @@ void SumoSession::continueLaneChange(VehicleRecord& v) {
 }
 
 void SumoSession::updateLaneChangeBound(VehicleRecord& v) {
-  ++guard_.lane_change_steps;
-  if (options_.guard_floor_speed_share > 0.0 && v.speed_mps < guardFloorMps(v)) {
-    // Queued or slowed down: the change must not also hold back how fast it gets going.
-    ++guard_.lane_change_released_steps;
-    restoreLaneChangeAcceleration(v);
-    return;
-  }
-  boundLaneChangeAcceleration(v);
+  // Queued or slowed down: the change must not also hold back how fast it gets going.
+  if (guard_.liftAdvisedChangeBound(guardCav(v))) restoreLaneChangeAcceleration(v);
+  else boundLaneChangeAcceleration(v);
 }
 
 void SumoSession::applyAdvisory(const std::string& id, int action_code, double accel_mps2) {
@@ -104,31 +99,25 @@ void SumoSession::applyAdvisory(const std::string& id, int action_code, double a
   if (action == Action::kAccelerate && !std::isfinite(accel_mps2))
     throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
                                 std::to_string(accel_mps2));
-  if (v.handed_back) {
-    // Its zone is busy: it drives itself, route and lane changes included (guard_busy_handback).
-    ++guard_.handback_advice_dropped;
+  AdviceCase advice;
+  advice.lane_change = lane_change;
+  advice.serves_route = (action == Action::kLaneRight && std::isfinite(v.distance_to_exit_m)) ||
+                        (action == Action::kLaneLeft && v.on_accel_lane);
+  advice.change_under_way = v.lane_change_target != 0;
+  advice.on_insertion_edge = v.edge == insertion_edge_;
+  advice.zone = zoneOf(v);
+  advice.time_s = time_s_;
+  const AdviceVerdict verdict = guard_.judgeAdvice(advice, v.guard);
+  if (verdict == AdviceVerdict::kDropHandedBack) {
+    // Its zone is busy: it drives itself, route and lane changes included.
     v.command = HeldCommand::kNone;
     return;
   }
+  if (verdict != AdviceVerdict::kCarryOut) {  // a refused change: it keeps its lane, as under KEEP
+    holdOwnDriving(v);
+    return;
+  }
   if (lane_change) {
-    ++guard_.lane_changes_advised;
-    const bool serves_route = (action == Action::kLaneRight && std::isfinite(v.distance_to_exit_m)) ||
-                              (action == Action::kLaneLeft && v.on_accel_lane);
-    const bool cooling = time_s_ - v.last_lane_change_s < options_.guard_lane_change_cooldown_s;
-    const bool busy = zoneBusy(zoneOf(v));
-    if (options_.guard_insertion_edge && v.edge == insertion_edge_ && v.lane_change_target == 0) {
-      // Where SUMO inserts vehicles: a sideways move there meets vehicles inserted into it.
-      ++guard_.lane_changes_insertion_refused;
-      holdOwnDriving(v);
-      return;
-    }
-    if (!serves_route && v.lane_change_target == 0 && (cooling || busy)) {
-      // Weaving for no need of its own route: moments after its last change, or where the
-      // road is busy.
-      ++(busy ? guard_.lane_changes_busy_refused : guard_.lane_changes_cooled_down);
-      holdOwnDriving(v);
-      return;
-    }
     v.lane_change_target = target_lane;
     v.lane_change_until_s = time_s_ + options_.lane_change_duration_s;
     updateLaneChangeBound(v);
@@ -168,25 +157,15 @@ void SumoSession::applyHeldCommand(VehicleRecord& v) {
     api::Vehicle::setSpeed(v.id, v.command_value);
     return;
   }
-  // Holding an acceleration: aim each step at the speed it reaches in one step. With the
-  // CAV's safe-speed check on (speed mode 31) that target only ever holds it below what its
-  // own car following would do, so the guard bounds how far: never below the floor.
-  ++guard_.accelerate_steps;
-  double target = std::max(0.0, v.speed_mps + v.command_value * step_length_s_);
-  const double floor = guardFloorMps(v);
-  if (target < floor) {
-    if (v.speed_mps < floor) {
-      // Already below it (queued, stopped, blocked): its own driving, at its own rate.
-      ++guard_.accelerate_released_steps;
-      if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
-      v.speed_overridden = false;
-      return;
-    }
-    ++guard_.accelerate_floored_steps;
-    target = floor;
+  // Holding an acceleration: the speed it reaches in one step, as the guard allows.
+  const HeldAcceleration held = guard_.holdAcceleration(guardCav(v), v.command_value, step_length_s_);
+  if (held.kind == HeldAcceleration::Kind::kReleased) {  // below the floor: its own driving
+    if (v.speed_overridden) api::Vehicle::setSpeed(v.id, -1.0);
+    v.speed_overridden = false;
+    return;
   }
   v.speed_overridden = true;
-  api::Vehicle::setSpeed(v.id, target);
+  api::Vehicle::setSpeed(v.id, held.target_mps);
 }
 
 }  // namespace palcas::sim

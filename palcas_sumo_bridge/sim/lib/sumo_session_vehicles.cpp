@@ -115,11 +115,11 @@ void SumoSession::readVehicles() {
     if (v.is_cav && options_.advisory_control) {
       if (v.merge_mode) updateMergeMode(v);
       updateHandback(v);
-      if (v.handed_back) ++guard_.handback_steps;
+      guard_.countCavStep(v.guard);
       // Its first read counts as a change too (lane and part were unknown): a CAV that
       // enters the road in a busy zone has just cut into its traffic.
       updateBusyChangeBound(v, v.lane != last_lane || v.part != last_part);
-      if (!options_.assist_mode && !v.handed_back) manageExit(v);
+      if (!options_.assist_mode && !v.guard.handed_back) manageExit(v);
     }
   }
 }

@@ -1,4 +1,4 @@
-// The advice guard (SessionOptions::guard_floor_speed_share) on the tiny road, in-process.
+// The advice guard (GuardOptions::floor_speed_share) on the tiny road, in-process.
 // The self-made jams of issue 18 came from ACCELERATE and the advised-change acceleration
 // bound holding CAVs below what their own car following would do: a queued CAV advised a
 // small positive acceleration left the queue at that rate, not its own, so a queue drained
@@ -50,14 +50,14 @@ std::string waitForFreeCav(SumoSession& session, double min_speed_mps, double ma
 
 TEST(AdviceGuard, AdviceNeverHoldsACavBelowTheFloorAndASlowCavDrivesItself) {
   SessionOptions options = palcas::sim::test::sessionOnTiny("advice_guard", 5);
-  options.guard_floor_speed_share = FLOOR_SHARE;
+  options.guard.floor_speed_share = FLOOR_SHARE;
   options.lane_change_max_accel_mps2 = 1.0;  // an advised change's bound, lifted when slow
-  options.guard_lane_change_cooldown_s = 10.0;
-  options.guard_busy_speed_share = 0.3;  // part 5: busy below 30 % of their top speeds
-  options.guard_busy_leave_share = 0.5;
-  options.guard_busy_window_s = 1.0;
-  options.guard_busy_handback = false;  // busy zones only refuse weaving (busy_handback_test)
-  options.guard_insertion_edge = false;  // its own test: insertion_guard_test
+  options.guard.lane_change_cooldown_s = 10.0;
+  options.guard.busy_speed_share = 0.3;  // part 5: busy below 30 % of their top speeds
+  options.guard.busy_leave_share = 0.5;
+  options.guard.busy_window_s = 1.0;
+  options.guard.busy_handback = false;  // busy zones only refuse weaving (busy_handback_test)
+  options.guard.insertion_edge = false;  // its own test: insertion_guard_test
   SumoSession session(options);
 
   // 1. Braking advice stops at the floor: -1.47 m/s^2 held for 12 s would take a CAV from

@@ -1,4 +1,4 @@
-// The guard's start (SessionOptions::guard_busy_at_start) on the tiny road, in-process. A road
+// The guard's start (GuardOptions::busy_at_start) on the tiny road, in-process. A road
 // that fills near capacity is advised in its first minute while its zones still count as free,
 // and that advice set off the breakdown (docs/journal/experiments.md, "Advice while the road
 // fills"). With the option on, every zone counts as busy from the start and its CAVs drive
@@ -24,11 +24,11 @@ bool inZone0(const VehicleRecord& v) {
 
 TEST(BusyAtStart, ZonesStartBusyAndAreAdvisedOnlyOnceTheyRunFree) {
   SessionOptions options = palcas::sim::test::sessionOnTiny("busy_at_start", 7);
-  options.guard_busy_at_start = true;
-  options.guard_busy_speed_share = 0.2;  // free traffic runs far above it
-  options.guard_busy_leave_share = 0.3;
-  options.guard_busy_window_s = 5.0;
-  options.guard_busy_handback = true;
+  options.guard.busy_at_start = true;
+  options.guard.busy_speed_share = 0.2;  // free traffic runs far above it
+  options.guard.busy_leave_share = 0.3;
+  options.guard.busy_window_s = 5.0;
+  options.guard.busy_handback = true;
   SumoSession session(options);
   session.step();
   for (int k = 0; k < static_cast<int>(session.road().clusters().size()); ++k)
@@ -39,7 +39,7 @@ TEST(BusyAtStart, ZonesStartBusyAndAreAdvisedOnlyOnceTheyRunFree) {
   for (int i = 0; i < 100 && early.empty() && session.zoneBusy(0); ++i) {
     session.step();
     for (const VehicleRecord& v : session.vehicles())
-      if (inZone0(v) && !v.merge_mode && v.handed_back) early = v.id;
+      if (inZone0(v) && !v.merge_mode && v.guard.handed_back) early = v.id;
   }
   ASSERT_FALSE(early.empty()) << "no CAV in zone 0 while it still counted as busy";
   const auto dropped = session.guardCounters().handback_advice_dropped;
@@ -55,7 +55,7 @@ TEST(BusyAtStart, ZonesStartBusyAndAreAdvisedOnlyOnceTheyRunFree) {
   int advised = 0;
   for (const VehicleRecord& v : session.vehicles()) {
     if (!inZone0(v) || v.merge_mode) continue;
-    EXPECT_FALSE(v.handed_back) << v.id << " still handed back in a free zone";
+    EXPECT_FALSE(v.guard.handed_back) << v.id << " still handed back in a free zone";
     session.applyAdvisory(v.id, ACCELERATE, 1.0);
     if (session.find(v.id)->command == palcas::sim::HeldCommand::kAccelerate) ++advised;
   }

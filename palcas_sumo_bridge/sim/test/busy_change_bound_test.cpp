@@ -1,5 +1,5 @@
-// The guard's bound on a busy zone's own lane changes (SessionOptions::
-// guard_busy_change_max_accel_mps2) on the tiny road, in-process. A CAV handed back in a busy
+// The guard's bound on a busy zone's own lane changes (GuardOptions::
+// busy_change_max_accel_mps2) on the tiny road, in-process. A CAV handed back in a busy
 // zone changes lanes by itself; around such a change (from when it moves sideways until
 // guard_busy_change_hold_s after it is in its new lane) it accelerates at most at the bound,
 // then its own acceleration comes back. Below the guard's floor it is never bounded.
@@ -27,7 +27,7 @@ constexpr double BOUND_MPS2 = 1.2, HOLD_S = 3.0, FLOOR_SHARE = 0.3;
 // change the test can start.
 std::string pickCav(const SumoSession& session) {
   for (const VehicleRecord& v : session.vehicles())
-    if (v.is_cav && v.handed_back && v.exit_cluster < 0 && !v.busy_change_bounded && v.part == RoadPart::kMainline &&
+    if (v.is_cav && v.guard.handed_back && v.exit_cluster < 0 && !v.guard.busy_change_bounded && v.part == RoadPart::kMainline &&
         v.lane <= 2 && !v.merge_mode && v.x_m > 20.0 && v.x_m < 200.0 &&
         v.speed_mps > 2.0 * FLOOR_SHARE * v.max_speed_mps && std::abs(v.lateral_speed_mps) < 0.05)
       return v.id;
@@ -76,7 +76,7 @@ TEST(BusyChangeBound, AnOwnChangeInABusyZoneAcceleratesGentlyThenItsOwnAccelCome
     const VehicleRecord* v = session.find(id);
     ASSERT_NE(v, nullptr);
     const double floor_mps = FLOOR_SHARE * std::min(v->max_speed_mps, libsumo::Vehicle::getAllowedSpeed(id));
-    if (!v->handed_back || v->speed_mps < floor_mps) continue;
+    if (!v->guard.handed_back || v->speed_mps < floor_mps) continue;
     EXPECT_DOUBLE_EQ(libsumo::Vehicle::getAccel(id), BOUND_MPS2) << "t " << session.timeS() << ", x " << v->x_m;
     ++held_steps;
   }
@@ -86,7 +86,7 @@ TEST(BusyChangeBound, AnOwnChangeInABusyZoneAcceleratesGentlyThenItsOwnAccelCome
     session.step();
     const VehicleRecord* v = session.find(id);
     ASSERT_NE(v, nullptr);
-    released = !v->busy_change_bounded;
+    released = !v->guard.busy_change_bounded;
   }
   EXPECT_TRUE(released) << id << " still bounded 20 s after its change";
   EXPECT_DOUBLE_EQ(libsumo::Vehicle::getAccel(id), own_accel) << id << ": its own accel back";
@@ -109,7 +109,7 @@ TEST(BusyChangeBound, AnOwnChangeInABusyZoneAcceleratesGentlyThenItsOwnAccelCome
     session.step();
     const VehicleRecord* v = session.find(slow);
     ASSERT_NE(v, nullptr);
-    EXPECT_FALSE(v->busy_change_bounded) << slow << " at " << v->speed_mps << " m/s, lane " << v->lane
+    EXPECT_FALSE(v->guard.busy_change_bounded) << slow << " at " << v->speed_mps << " m/s, lane " << v->lane
                                          << " (from " << slow_lane << ")";
   }
 }

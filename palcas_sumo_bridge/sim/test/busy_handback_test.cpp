@@ -1,4 +1,4 @@
-// The guard's hand-back (SessionOptions::guard_busy_handback) on the tiny road, in-process.
+// The guard's hand-back (GuardOptions::busy_handback) on the tiny road, in-process.
 // In advisory mode the RSUs alone serve the exits; where a zone's traffic has broken down
 // that costs up to 30 % of the road's speed (README "Advice that does no harm"). In a busy
 // zone a CAV therefore gets its own route-aware driving back (route to its off-ramp, SUMO's
@@ -44,20 +44,20 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   SessionOptions options = palcas::sim::test::sessionOnTiny("busy_handback", 7);
   // Busy below 20 % of their top speeds, free again above 30 %: a zone slowed to a crawl
   // refills from a standing queue at the road's start, which keeps its share near 0.4.
-  options.guard_busy_speed_share = 0.2;
-  options.guard_busy_leave_share = 0.3;
-  options.guard_busy_window_s = 1.0;
-  options.guard_busy_handback = true;
+  options.guard.busy_speed_share = 0.2;
+  options.guard.busy_leave_share = 0.3;
+  options.guard.busy_window_s = 1.0;
+  options.guard.busy_handback = true;
   options.assist_lane_change_mode = OWN_LANE_CHANGE_MODE;
-  options.guard_busy_lc_assertive = BUSY_LC_ASSERTIVE;
+  options.guard.busy_lc_assertive = BUSY_LC_ASSERTIVE;
   // Advice that runs again at the end may pick any zone-0 CAV, on the warm-up edge too.
-  options.guard_insertion_edge = false;
+  options.guard.insertion_edge = false;
   SumoSession session(options);
   for (int i = 0; i < 600; ++i) session.step();  // the road fills
 
   // Free traffic: nobody handed back, lane changes are the RSUs'.
   for (const VehicleRecord& v : session.vehicles()) {
-    EXPECT_FALSE(v.handed_back) << v.id << " handed back on a free road";
+    EXPECT_FALSE(v.guard.handed_back) << v.id << " handed back on a free road";
     if (inZone0(v) && !v.merge_mode) { EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE); }
     if (v.is_cav) { EXPECT_DOUBLE_EQ(lcAssertive(v.id), 1.0) << v.id << ": its vType's gap acceptance"; }
   }
@@ -75,11 +75,11 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   std::string sample;
   for (const VehicleRecord& v : session.vehicles()) {
     if (!inZone0(v) || v.merge_mode) {
-      if (v.part == RoadPart::kMainline && v.x_m > 305.0) { EXPECT_FALSE(v.handed_back) << v.id << " in the free zone 1"; }
+      if (v.part == RoadPart::kMainline && v.x_m > 305.0) { EXPECT_FALSE(v.guard.handed_back) << v.id << " in the free zone 1"; }
       continue;
     }
-    EXPECT_TRUE(v.handed_back) << v.id << " at x " << v.x_m << " in busy zone 0";
-    if (!v.handed_back) continue;
+    EXPECT_TRUE(v.guard.handed_back) << v.id << " at x " << v.x_m << " in busy zone 0";
+    if (!v.guard.handed_back) continue;
     ++handed_back;
     EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), OWN_LANE_CHANGE_MODE) << v.id;
     EXPECT_DOUBLE_EQ(lcAssertive(v.id), BUSY_LC_ASSERTIVE) << v.id << ": the busy zone's gap acceptance";
@@ -116,7 +116,7 @@ TEST(BusyHandback, ABusyZonesCavsDriveThemselvesAndComeBackWhenItIsFree) {
   int back = 0;
   for (const VehicleRecord& v : session.vehicles()) {
     if (!inZone0(v) || v.merge_mode) continue;
-    EXPECT_FALSE(v.handed_back) << v.id;
+    EXPECT_FALSE(v.guard.handed_back) << v.id;
     EXPECT_EQ(libsumo::Vehicle::getLaneChangeMode(v.id), ADVISED_LANE_CHANGE_MODE) << v.id;
     EXPECT_DOUBLE_EQ(lcAssertive(v.id), 1.0) << v.id << ": its own gap acceptance back";
     if (std::isfinite(v.distance_to_exit_m) && !v.exit_committed) {

@@ -29,7 +29,7 @@ constexpr double BOUND_MPS2 = 1.2, HOLD_S = 60.0, FLOOR_SHARE = 0.3;
 // leader within 80 m: {cav, leader}, or empty.
 std::pair<std::string, std::string> pickBoundedCavWithLeader(const SumoSession& session) {
   for (const VehicleRecord& v : session.vehicles()) {
-    if (!v.is_cav || !v.handed_back || !v.busy_change_bounded || v.part != RoadPart::kMainline ||
+    if (!v.is_cav || !v.guard.handed_back || !v.guard.busy_change_bounded || v.part != RoadPart::kMainline ||
         v.speed_mps < 1.5 * FLOOR_SHARE * v.max_speed_mps)
       continue;
     const auto ahead = libsumo::Vehicle::getLeader(v.id, 80.0);
@@ -42,7 +42,7 @@ std::pair<std::string, std::string> pickBoundedCavWithLeader(const SumoSession& 
 TEST(CollisionAttribution, CountsOnlyCavsAndEachGuardStateTheyWereIn) {
   GuardCounters g;
   VehicleRecord hdv;
-  hdv.handed_back = true;  // an HDV is never handed back; were it, it still would not count
+  hdv.guard.handed_back = true;  // an HDV is never handed back; were it, it still would not count
   countCollidedUnderGuard(hdv, &g);
   EXPECT_EQ(g.collided_cavs, 0u);
   EXPECT_EQ(g.collided_handed_back, 0u);
@@ -54,8 +54,8 @@ TEST(CollisionAttribution, CountsOnlyCavsAndEachGuardStateTheyWereIn) {
   countCollidedUnderGuard(advised, &g);
   VehicleRecord own_change;
   own_change.is_cav = true;
-  own_change.handed_back = true;
-  own_change.busy_change_bounded = true;
+  own_change.guard.handed_back = true;
+  own_change.guard.busy_change_bounded = true;
   countCollidedUnderGuard(own_change, &g);
   VehicleRecord free_driving;
   free_driving.is_cav = true;
@@ -92,7 +92,7 @@ TEST(CollisionAttribution, ABoundedCavThatCollidesIsCountedAsBoundedAndHandedBac
     collided = std::find(events.collided.begin(), events.collided.end(), id) != events.collided.end();
     if (!collided) {
       ASSERT_NE(session.find(id), nullptr) << id << " left the road without colliding";
-      ASSERT_TRUE(session.find(id)->busy_change_bounded) << id << " released before it reached " << leader;
+      ASSERT_TRUE(session.find(id)->guard.busy_change_bounded) << id << " released before it reached " << leader;
     }
   }
   ASSERT_TRUE(collided) << id << " never reached " << leader;

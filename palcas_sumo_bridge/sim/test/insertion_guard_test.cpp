@@ -1,4 +1,4 @@
-// The advice guard where traffic is inserted (SessionOptions::guard_insertion_edge), on the
+// The advice guard where traffic is inserted (GuardOptions::insertion_edge), on the
 // tiny road, in-process. Every CAV collision in the shipped policy's evaluation runs (issue
 // 18) was on the warm-up edge: SUMO 1.15 inserts mainline vehicles there at a random free
 // place at the highest safe speed, and a vehicle inserted beside or just behind a CAV that
@@ -26,9 +26,9 @@ constexpr int LANE_LEFT = 0, LANE_RIGHT = 1;
 
 SessionOptions busyTinyRoad(bool guard_on) {
   SessionOptions o = palcas::sim::test::sessionOnTiny(guard_on ? "insertion_on" : "insertion_off", 11, 2000.0);
-  o.guard_insertion_edge = guard_on;
-  o.guard_busy_speed_share = 0.0;  // busy zones would drop the advice: this test is about insertion
-  o.guard_busy_leave_share = 0.0;
+  o.guard.insertion_edge = guard_on;
+  o.guard.busy_speed_share = 0.0;  // busy zones would drop the advice: this test is about insertion
+  o.guard.busy_leave_share = 0.0;
   return o;
 }
 

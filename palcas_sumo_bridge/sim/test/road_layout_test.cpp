@@ -75,3 +75,22 @@ TEST(RoadLayout, RejectsBadInput) {
                                          {"off_3", {}, -1, 700, 780, 1, false}};
   EXPECT_THROW(RoadLayout(ramp_beyond_road, 5, 800.0), std::invalid_argument);
 }
+
+TEST(RoadLayout, ZoneAtSplitsTheRoadAsTheRsusDo) {
+  const RoadLayout road = twoClusterRoad();
+  EXPECT_EQ(road.zoneAt(0.0), 0);
+  EXPECT_EQ(road.zoneAt(799.9), 0);
+  EXPECT_EQ(road.zoneAt(800.0), 1);  // [x_start, x_end): a boundary is the next zone's
+  EXPECT_EQ(road.zoneAt(1599.9), 1);
+  EXPECT_EQ(road.zoneAt(1600.0), -1);  // the road's end is in no zone
+  EXPECT_EQ(road.zoneAt(-0.1), -1);
+}
+
+TEST(RoadLayout, ZoneAtEndsTheLastZoneWithTheMainline) {
+  // A mainline of 1500 m in zones of 800 m: the second zone is [800, 1500).
+  std::vector<EdgeInfo> e{{"main_0_up", {}, -1, 0.0, 1500.0, 2, false}};
+  const RoadLayout road(e, 2, 800.0);
+  ASSERT_EQ(road.clusters().size(), 2u);
+  EXPECT_EQ(road.zoneAt(1499.9), 1);
+  EXPECT_EQ(road.zoneAt(1500.0), -1);
+}

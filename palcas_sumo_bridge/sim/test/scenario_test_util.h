@@ -85,16 +85,16 @@ inline SessionOptions sessionOnTiny(const std::string& dir_name, unsigned seed =
 inline SessionOptions sessionOnTinyEveryZoneBusy(const std::string& dir_name, unsigned seed, double bound_mps2,
                                                  double hold_s, double floor_share) {
   SessionOptions o = sessionOnTiny(dir_name, seed);
-  o.guard_busy_speed_share = 1.5;
-  o.guard_busy_leave_share = 1.6;
-  o.guard_busy_window_s = 1.0;
-  o.guard_busy_handback = true;
+  o.guard.busy_speed_share = 1.5;
+  o.guard.busy_leave_share = 1.6;
+  o.guard.busy_window_s = 1.0;
+  o.guard.busy_handback = true;
   o.assist_lane_change_mode = 1621;
-  o.guard_busy_lc_assertive = 0.0;
-  o.guard_floor_speed_share = floor_share;
-  o.guard_busy_change_max_accel_mps2 = bound_mps2;
-  o.guard_busy_change_hold_s = hold_s;
-  o.guard_insertion_edge = false;
+  o.guard.busy_lc_assertive = 0.0;
+  o.guard.floor_speed_share = floor_share;
+  o.guard.busy_change_max_accel_mps2 = bound_mps2;
+  o.guard.busy_change_hold_s = hold_s;
+  o.guard.insertion_edge = false;
   return o;
 }
 

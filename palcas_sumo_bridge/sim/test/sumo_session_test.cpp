@@ -23,10 +23,10 @@ constexpr int LANE_LEFT = 0, ACCELERATE = 2, KEEP = 3;
 
 SessionOptions tinyOptions() {
   SessionOptions o = palcas::sim::test::sessionOnTiny("session");
-  o.guard_floor_speed_share = 0.0;  // the actuation itself (advice_guard_test: with the guard)
-  o.guard_busy_speed_share = 0.0;
-  o.guard_busy_leave_share = 0.0;
-  o.guard_insertion_edge = false;  // its own test: insertion_guard_test
+  o.guard.floor_speed_share = 0.0;  // the actuation itself (advice_guard_test: with the guard)
+  o.guard.busy_speed_share = 0.0;
+  o.guard.busy_leave_share = 0.0;
+  o.guard.insertion_edge = false;  // its own test: insertion_guard_test
   return o;
 }
 // The lane-change model checks the others' gaps (cav_lane_change_mode 1536): pick a CAV

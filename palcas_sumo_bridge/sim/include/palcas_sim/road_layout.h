@@ -65,6 +65,9 @@ class RoadLayout {
   double clusterLengthM() const { return cluster_length_m_; }
   /// Cluster whose zone holds x (clamped to the first/last cluster).
   int clusterAt(double x_m) const;
+  /// RSU zone (cluster) whose [x_start_m, x_end_m) holds x, as the RSUs split the road;
+  /// -1 outside every zone. The session's one zone lookup (the advice guard's too).
+  int zoneAt(double x_m) const;
   /// Mainline edges in driving order (a road of the naming convention: ordered by x).
   const std::vector<std::string>& mainline() const { return mainline_; }
   /// true: x is measured along the lanes (xAlongMainline); false: x is SUMO's x coordinate.

@@ -13,6 +13,7 @@
 
 #include "palcas_core/common/action.h"
 #include "palcas_core/common/road_terms.h"
+#include "palcas_sim/advice_guard.h"
 #include "palcas_sim/own_road.h"
 #include "palcas_sim/road_layout.h"
 
@@ -73,67 +74,9 @@ struct SessionOptions {
   /// gap with decel, so a small decel bound makes the CAV drop far back while it changes.
   double lane_change_max_accel_mps2 = 0.0;
   double lane_change_max_decel_mps2 = 0.0;
-  /// The advice guard's speed floor, as a share of the CAV's allowed speed (its lane's limit,
-  /// or its own top speed if lower). Advice may slow a CAV down to the floor, never below:
-  /// an ACCELERATE that would take it lower stops at the floor, and a CAV already below it
-  /// (queued, stopped, blocked) drives itself, ACCELERATE commands and the advised-change
-  /// acceleration bound lifted, so it leaves a queue at its own car following's rate. 0 = off
-  /// (the paper: the advised acceleration always reaches the car).
-  double guard_floor_speed_share = 0.6;
-  /// The advice guard's lane-change cooldown [s]: after an advised change, another advised
-  /// change that does not serve the CAV's route (a RIGHT towards its exit, a LEFT off the
-  /// acceleration lane) is not carried out for this long; the CAV keeps its lane and its own
-  /// driving (as under KEEP). Bounds the weaving an advisory policy can cause. 0 = off.
-  double guard_lane_change_cooldown_s = 0.0;
-  /// The advice guard in busy traffic: a zone whose mainline vehicles drive, on average over
-  /// the last guard_busy_window_s, below this share of their own top speeds is busy until
-  /// that share is back above guard_busy_leave_share. In a busy zone an advised change that
-  /// does not serve the CAV's route is not carried out (the CAV keeps its lane, as under
-  /// KEEP): weaving for speed gain costs a busy road more than it gains. 0 = off.
-  double guard_busy_speed_share = 0.8;
-  double guard_busy_leave_share = 0.88;
-  double guard_busy_window_s = 30.0;
-  /// true: a zone counts as busy from the start until its smoothed speed share, starting from
-  /// 0, has risen above guard_busy_leave_share (a window or two of free running: advice starts
-  /// where the road has shown it runs free); false: an empty zone starts free, and the first
-  /// minute of a road filling near capacity is advised.
-  bool guard_busy_at_start = false;
-  /// The floor's share in a busy zone (1 = advice slows nobody there: its CAVs drive
-  /// themselves; guard_floor_speed_share elsewhere).
-  double guard_busy_floor_speed_share = 1.0;
-  /// The guard's hand-back in a busy zone (advisory mode): its CAVs get their own route-aware
-  /// driving back, as in assist mode: a route to their off-ramp and SUMO's own lane changes
-  /// (assist_lane_change_mode), and no advice is carried out for them, until their zone is
-  /// free again (then lane changes are the RSUs' again). Where the road is busy, the CAVs
-  /// then drive as SUMO's drivers would, which an advisory mode that serves the exits by
-  /// advice alone cannot match there. In assist mode it only drops their advice (they drive
-  /// themselves already). false: a busy zone only refuses weaving (guard_busy_speed_share).
-  bool guard_busy_handback = true;
-  /// SUMO's lcAssertive for a CAV in a busy zone that makes its own lane changes (handed back,
-  /// or in assist mode): SL2015 divides the front and rear gaps a change needs by it (its
-  /// default 1). The RSU sees every vehicle around the CAV, so in a busy zone it can clear the
-  /// CAV for a gap its own sensors would not take: merges and exit changes into dense lanes
-  /// happen sooner instead of queueing. Its own value comes back when the zone is free.
-  /// 2 (chosen near capacity: docs/journal/experiments.md, "Tighter gaps in busy zones"; the
-  /// rule arms carry it too, sumo_native does not); 0 = off (the vType's value everywhere).
-  double guard_busy_lc_assertive = 2.0;
-  /// Largest acceleration [m/s^2] of a CAV in a busy zone around a lane change of its own
-  /// (handed back, or in assist mode): from when it starts moving sideways until
-  /// guard_busy_change_hold_s after it is in its new lane. Tighter gaps mean more changes and
-  /// a hard speed-up into each gap; the RSU asks for the comfort band instead, as for an
-  /// advised change (lane_change_max_accel_mps2). Not below the guard's floor
-  /// (guard_floor_speed_share): a slow or queued CAV gets going at its own rate. 1.47 = a_th
-  /// (the default: docs/journal/experiments.md, "Gentle acceleration around a busy zone's own
-  /// lane changes"); 0 = off.
-  double guard_busy_change_max_accel_mps2 = 1.47;
-  double guard_busy_change_hold_s = 4.0;
-  /// The advice guard where traffic is inserted: no advised lane change is carried out on the
-  /// mainline edge where SUMO inserts the mainline's vehicles (the warm-up edge); the CAV keeps
-  /// its lane and drives itself, as under KEEP. SUMO 1.15 inserts a vehicle (departPos
-  /// random_free, departSpeed max) beside or just behind a CAV that is moving sideways into
-  /// that lane, and the two collide: every CAV collision of the shipped policy's evaluation
-  /// runs was there (issue 18). false = off (the paper: advice applies from x = 0).
-  bool guard_insertion_edge = true;
+  /// The advice guard (advice_guard.h): what of the advice a CAV carries out, busy zones and
+  /// their hand-back. Its keys and what they mean: config/bridge.yaml, guard_*.
+  GuardOptions guard;
   /// Assist mode (arm palcas_assist): CAVs keep their own route-aware driving, as a road
   /// operator's fleet would: their route runs to their off-ramp from the start and SUMO's
   /// lane-change model makes its own strategic, cooperative and speed-gain changes
@@ -145,32 +88,6 @@ struct SessionOptions {
   /// of its own unless a TraCI request conflicts, requests respect the others' gaps, sublane
   /// alignment).
   int assist_lane_change_mode = 1621;
-};
-
-/// How often the advice guard (SessionOptions::guard_floor_speed_share) acted, in CAV steps.
-struct GuardCounters {
-  std::uint64_t accelerate_steps = 0;         ///< CAV steps under an ACCELERATE command
-  std::uint64_t accelerate_floored_steps = 0; ///< ... held at the floor instead of the command
-  std::uint64_t accelerate_released_steps = 0;///< ... driven by its own model (below the floor)
-  std::uint64_t lane_change_steps = 0;        ///< CAV steps with an advised change under way
-  std::uint64_t lane_change_released_steps = 0;///< ... with the acceleration bound lifted
-  std::uint64_t lane_changes_advised = 0;       ///< advised changes received
-  std::uint64_t lane_changes_cooled_down = 0;   ///< ... not carried out (cooldown)
-  std::uint64_t lane_changes_busy_refused = 0;  ///< ... not carried out (busy zone)
-  std::uint64_t lane_changes_insertion_refused = 0;  ///< ... not carried out (insertion edge)
-  std::uint64_t busy_zone_steps = 0;            ///< zone steps a zone was busy (all zones)
-  std::uint64_t handbacks = 0;                  ///< CAVs handed back to their own driving
-  std::uint64_t handback_steps = 0;             ///< CAV steps spent handed back
-  std::uint64_t handback_advice_dropped = 0;    ///< advisories not carried out (handed back)
-  std::uint64_t busy_change_bounds = 0;         ///< own changes in a busy zone whose accel was bounded
-  std::uint64_t busy_change_bound_steps = 0;    ///< CAV steps under that bound
-  std::uint64_t zone_steps = 0;                 ///< zone steps in all (zones x steps)
-  // Which guard, if any, had a hand on a CAV when it collided (a CAV can count in several).
-  std::uint64_t collided_cavs = 0;                 ///< CAVs removed after a collision
-  std::uint64_t collided_handed_back = 0;          ///< ... handed back to their own driving
-  std::uint64_t collided_busy_change_bounded = 0;  ///< ... under the busy zones' change bound
-  std::uint64_t collided_advised_change = 0;       ///< ... with an advised lane change under way
-  std::uint64_t collided_accelerate = 0;          ///< ... holding an ACCELERATE advisory
 };
 
 /// One vehicle on the road, updated every step.
@@ -211,12 +128,9 @@ struct VehicleRecord {
   bool exit_committed = false; ///< SUMO target switched to its off-ramp
   bool speed_overridden = false; ///< a setSpeed of ours is in force (else SUMO's own model)
   bool merge_mode = false;       ///< strategic lane changes allowed (own_merge, accel lane)
-  bool handed_back = false;      ///< busy zone: its own route-aware driving, advice dropped
+  GuardMemory guard;             ///< what the advice guard remembers of it
   std::string own_lc_assertive;  ///< its lcAssertive before a busy zone changed it (empty: unchanged)
-  /// guard_busy_change_max_accel_mps2: the bound's end [s] and the accel it replaced.
-  double busy_change_until_s = -1e18;
-  bool busy_change_bounded = false;
-  double busy_change_own_accel_mps2 = 0.0;
+  double busy_change_own_accel_mps2 = 0.0;  ///< its accel before the busy zones' change bound
   /// Advised lane change under way, in paper lanes: SUMO's request is per lane index of
   /// the current edge, so it is re-issued when the vehicle enters an edge whose indices
   /// differ (a merge edge), until the target lane is reached or the time is up.
@@ -225,8 +139,6 @@ struct VehicleRecord {
   std::string lane_change_edge;     ///< edge the request was last issued on
   /// The vehicle's own accel / decel while an advised change bounds them (restored after).
   bool lane_change_bounded = false;
-  /// Simulation time the last advised change was made (-inf: none yet), for the cooldown.
-  double last_lane_change_s = -1e18;
   double own_accel_mps2 = 0.0, own_decel_mps2 = 0.0;
 };
 
@@ -295,13 +207,13 @@ class SumoSession {
   /// Exit commitments / withdrawals SUMO refused (the vehicle kept its route).
   std::uint64_t routeChangesFailed() const { return route_changes_failed_; }
   /// How often the advice guard acted (all zero when it is off).
-  const GuardCounters& guardCounters() const { return guard_; }
+  const GuardCounters& guardCounters() const { return guard_.counters(); }
   /// The guard's floor for this CAV [m/s] (0 when the guard is off).
-  double guardFloorMps(const VehicleRecord& v) const;
-  /// Whether zone k is busy now (always false with guard_busy_speed_share 0).
-  bool zoneBusy(int cluster) const;
+  double guardFloorMps(const VehicleRecord& v) const { return guard_.floorMps(guardCav(v)); }
+  /// Whether zone k is busy now (always false with busy zones off).
+  bool zoneBusy(int cluster) const { return guard_.zoneBusy(cluster); }
   /// Zone k's smoothed mean of speed / own top speed of its mainline vehicles.
-  double zoneSpeedShare(int cluster) const;
+  double zoneSpeedShare(int cluster) const { return guard_.zoneSpeedShare(cluster); }
   /// Vehicles SUMO dropped at insertion so far: loaded from a flow, never departed, no
   /// longer waiting (they waited longer than --max-depart-delay). Asks SUMO.
   std::uint64_t insertionDropped() const;
@@ -336,19 +248,18 @@ class SumoSession {
   void requestLaneChange(VehicleRecord& v, double duration_s);
   void applyHeldCommand(VehicleRecord& v);
   void updateMergeMode(VehicleRecord& v);
-  /// guard_busy_handback: hands a CAV in a busy zone back to its own route-aware driving,
+  /// The guard's hand-back: hands a CAV in a busy zone back to its own route-aware driving,
   /// and takes it back once its zone is free.
   void updateHandback(VehicleRecord& v);
-  /// guard_busy_lc_assertive: a busy zone's gap acceptance for a CAV making its own changes,
-  /// or its own value back (busy false).
+  /// A busy zone's gap acceptance for a CAV making its own changes, or its own value back
+  /// (busy false).
   void setBusyGapAcceptance(VehicleRecord& v, bool busy) const;
-  /// guard_busy_change_max_accel_mps2: bounds a handed-back CAV's acceleration around a lane
-  /// change of its own (switched: it is in another lane or road part than a step ago), and
-  /// lifts the bound after it.
+  /// The busy zones' change bound on a handed-back CAV's acceleration around a lane change
+  /// of its own (switched: it is in another lane or road part than a step ago).
   void updateBusyChangeBound(VehicleRecord& v, bool switched);
   void releaseBusyChangeBound(VehicleRecord& v);
-  /// share x the CAV's allowed speed (its lane's limit, or its own top speed if lower); 0 if share <= 0.
-  double floorMps(const VehicleRecord& v, double share) const;
+  /// The CAV as the guard sees it now (its allowed speed asked of SUMO only if needed).
+  GuardCav guardCav(const VehicleRecord& v) const;
   /// Sets a CAV's route to the rest of its own (to its off-ramp); false when it is not on it.
   bool routeToOwnExit(VehicleRecord& v);
   void removeVehicle(const std::string& id, std::vector<VehicleRecord>* removed);
@@ -370,13 +281,11 @@ class SumoSession {
   bool open_ = false;
   std::uint64_t lane_changes_done_ = 0, lane_changes_dropped_ = 0, vanished_vehicles_ = 0;
   std::uint64_t route_changes_failed_ = 0;
-  GuardCounters guard_;
-  /// Per zone: smoothed speed share of its mainline vehicles, and whether it is busy.
-  std::vector<double> zone_speed_share_;
-  std::vector<bool> zone_busy_;
+  AdviceGuard guard_;
+  /// The guard's zones, from this step's mainline vehicles.
   void updateZones();
-  /// RSU zone (cluster) a vehicle's x falls in; may be outside [0, clusters).
-  int zoneOf(const VehicleRecord& v) const;
+  /// RSU zone (cluster) a vehicle's x falls in (RoadLayout::zoneAt), -1 = none.
+  int zoneOf(const VehicleRecord& v) const { return road_->zoneAt(v.x_m); }
   /// No command of ours: its own car following (or, with own_car_following off, its speed).
   void holdOwnDriving(VehicleRecord& v) const;
   std::uint64_t loaded_vehicles_ = 0, departed_vehicles_ = 0;  ///< since the start
