@@ -37,7 +37,7 @@ from junit_runner import run_as_junit  # noqa: E402
 def args(**kw):
     # The dev seed set (101, 102, ...): the fake points below are named after its seeds.
     base = dict(arms="keep,sumo_native", prs="5,60", seeds=2, seed_set="dev", duration=600.0,
-                scenario="tiny", policy=None, jobs=1, demands=None, v2x="", bridge_params="")
+                scenario="tiny", policy=None, jobs=1, demands=None, v2x="", bridge_params="", inprocess=False)
     base.update(kw)
     return argparse.Namespace(**base)
 
@@ -92,6 +92,17 @@ class PlannerTest(unittest.TestCase):
         self.assertEqual(len(lines), 8)
         self.assertTrue(all("./palcas experiment --point " in line for line in lines))
         self.assertIn("#SBATCH --array=1-8", (self.out / "slurm_array.sh").read_text())
+
+    def test_in_process_reaches_every_point_and_may_change_between_calls(self):
+        s = experiment.settings_from_args(args())
+        p = experiment.points_of(s)[0]
+        self.assertNotIn("--in-process", experiment.point_argv(s, p, self.out / "p"))
+        experiment.save_settings(self.out, s)
+        merged = experiment.merge_settings(self.out, experiment.settings_from_args(args(inprocess=True)))
+        self.assertTrue(merged["inprocess"])
+        argv = experiment.point_argv(merged, p, self.out / "p")
+        self.assertIn("--in-process", argv)
+        self.assertEqual(argv[:4], ["--arm", p["arm"], "--no-compare", "--pr"])
 
     def test_bad_options_are_named(self):
         for kw, text in ((dict(arms="keep,nope"), "nope"), (dict(prs="5,101"), "101"),

@@ -132,7 +132,8 @@ def settings_from_args(a):
                              f"seeds of {policy}")
         policies[arm] = repo_paths.recorded(policy)  # experiment.json: repository-relative
     settings = {"arms": arms, "prs": prs, "seeds": seeds, "seed_set": seed_set, "duration_s": float(a.duration),
-                "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms}}
+                "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms},
+                "inprocess": bool(a.inprocess)}
     if demands is not None:
         settings["demands"] = demands
     for key, option in POINT_FILES:
@@ -188,6 +189,9 @@ def merge_settings(out, wanted):
         if key in have:
             merged[key] = have[key] + [v for v in wanted[key] if v not in have[key]]
     merged["policies"] = {**have["policies"], **wanted["policies"]}
+    # How the points run, not what they measure (the same decisions either way: RSU nodes or
+    # in process): the latest call's choice.
+    merged["inprocess"] = wanted.get("inprocess", False)
     return merged
 
 
@@ -256,6 +260,24 @@ def last_error(point_log, console):
     return (own[-1] if own else "no output")[:300]
 
 
+def point_argv(settings, p, d):
+    """./palcas run's command line (after "run") for point p of the experiment, into folder d."""
+    argv = ["--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}", "--seed", str(p["seed"]),
+            "--duration", f"{settings['duration_s']:g}", "--scenario", settings["scenario"], "--out", str(d)]
+    if p["demand"] is not None:
+        argv += ["--demand", f"{p['demand']:g}"]
+    if p["arm"] in settings["policies"]:
+        argv += ["--policy", repo_paths.usable(settings["policies"][p["arm"]])]
+    if not p["trajectories"]:
+        argv += ["--no-trajectories"]
+    if settings.get("inprocess"):
+        argv += ["--in-process"]
+    for key, option in POINT_FILES:
+        if settings.get(key):
+            argv += [option, repo_paths.usable(settings[key])]
+    return argv
+
+
 def run_point(out, name):
     """Runs one point with ./palcas run's code, its output in the point's point.log, and writes
     its point.json; returns the exit code (130 / 143 if the experiment was interrupted)."""
@@ -266,17 +288,7 @@ def run_point(out, name):
     p = pts[name]
     d = point_dir(out, p)
     d.mkdir(parents=True, exist_ok=True)
-    argv = ["--arm", p["arm"], "--no-compare", "--pr", f"{p['pr']:g}", "--seed", str(p["seed"]),
-            "--duration", f"{settings['duration_s']:g}", "--scenario", settings["scenario"], "--out", str(d)]
-    if p["demand"] is not None:
-        argv += ["--demand", f"{p['demand']:g}"]
-    if p["arm"] in settings["policies"]:
-        argv += ["--policy", repo_paths.usable(settings["policies"][p["arm"]])]
-    if not p["trajectories"]:
-        argv += ["--no-trajectories"]
-    for key, option in POINT_FILES:
-        if settings.get(key):
-            argv += [option, repo_paths.usable(settings[key])]
+    argv = point_argv(settings, p, d)
     start = time.time()
     with open(d / "point.log", "w") as log:
         point_console = Console(out=log, err=log)
@@ -412,6 +424,9 @@ def common_options(p):
                    help=D("an RSU parameter override for every point (./palcas run --rsu-params)", "none"))
     p.add_argument("--bridge-params", dest="bridge_params", default="", metavar="FILE",
                    help=D("a bridge parameter override for every point (./palcas run --bridge-params)", "none"))
+    p.add_argument("--in-process", dest="inprocess", action="store_true",
+                   help=D("every point's RSUs inside its bridge process (./palcas run --in-process: the same "
+                          "decisions, no wall-time deadline to miss); may change between calls", "off: RSU nodes"))
     p.add_argument("--policy", action="append", metavar="ARM=DIR",
                    help=D("a policy for a learning arm (repeatable)", "policies/<arm>/"))
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1, metavar="J",
