@@ -133,7 +133,8 @@ def settings_from_args(a):
         policies[arm] = repo_paths.recorded(policy)  # experiment.json: repository-relative
     settings = {"arms": arms, "prs": prs, "seeds": seeds, "seed_set": seed_set, "duration_s": float(a.duration),
                 "scenario": a.scenario, "policies": {k: v for k, v in policies.items() if k in arms},
-                "inprocess": bool(a.inprocess)}
+                # A programmatic caller may leave --in-process out.
+                "inprocess": bool(getattr(a, "inprocess", False))}
     if demands is not None:
         settings["demands"] = demands
     for key, option in POINT_FILES:
