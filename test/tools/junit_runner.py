@@ -11,17 +11,28 @@ class JUnitResult(unittest.TextTestResult):
         super().__init__(*a, **kw)
         self.cases = []
 
+    def add(self, test, failure, detail=""):
+        cls, _, case = test.id().rpartition(".")
+        self.cases.append((cls, case + detail, failure))
+
     def addSuccess(self, test):
         super().addSuccess(test)
-        self.cases.append((test.id(), None))
+        self.add(test, None)
 
     def addFailure(self, test, err):
         super().addFailure(test, err)
-        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
+        self.add(test, self._exc_info_to_string(err, test))
 
     def addError(self, test, err):
         super().addError(test, err)
-        self.cases.append((test.id(), self._exc_info_to_string(err, test)))
+        self.add(test, self._exc_info_to_string(err, test))
+
+    def addSubTest(self, test, subtest, err):
+        # A failed subTest fails its test, and unittest then reports the test neither as a
+        # success nor as a failure: without this the XML would not count it at all.
+        super().addSubTest(test, subtest, err)
+        if err is not None:
+            self.add(test, self._exc_info_to_string(err, test), " " + subtest._subDescription())
 
 
 def run_as_junit(module, suite_name):
@@ -33,13 +44,12 @@ def run_as_junit(module, suite_name):
     result = unittest.TextTestRunner(resultclass=JUnitResult, verbosity=2).run(suite)
     if a.xml:
         pathlib.Path(a.xml).parent.mkdir(parents=True, exist_ok=True)
-        failed = sum(1 for _, f in result.cases if f)
+        failed = sum(1 for _, _, f in result.cases if f)
         with open(a.xml, "w") as f:
             f.write('<?xml version="1.0" encoding="UTF-8"?>\n')
             f.write(f'<testsuite name="{suite_name}" tests="{len(result.cases)}" '
                     f'failures="{failed}" errors="0">\n')
-            for name, failure in result.cases:
-                cls, _, case = name.rpartition(".")
+            for cls, case, failure in result.cases:
                 if failure:
                     f.write(f'  <testcase classname={quoteattr(cls)} name={quoteattr(case)}>'
                             f'<failure message={quoteattr(failure[-500:])}/></testcase>\n')
