@@ -286,6 +286,8 @@ void BridgeNode::reject(const std::string& rsu_id, const std::string& vehicle_id
   ROS_DEBUG_NAMED("advice", "palcas bridge: step %lu: rejected advisory from '%s' for '%s': %s (%s)",
                   static_cast<unsigned long>(r.step), rsu_id.c_str(), vehicle_id.c_str(),
                   metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(reason)).c_str(), detail.c_str());
+  // The guard declines advice in every run with busy zones: expected, not a fault to warn of.
+  if (metrics::isGuardRefusal(static_cast<metrics::RejectionReason>(reason))) return;
   ROS_WARN_THROTTLE_NAMED(2.0, "advice", "palcas bridge: rejected advisory from '%s' for '%s': %s (%s)",
                     rsu_id.c_str(), vehicle_id.c_str(),
                     metrics::rejectionReasonName(static_cast<metrics::RejectionReason>(reason)).c_str(),

@@ -11,6 +11,30 @@
 namespace palcas::sim {
 namespace {
 
+/// The rejection reason that reports a guard's verdict other than kCarryOut.
+metrics::RejectionReason guardRejection(AdviceVerdict verdict) {
+  switch (verdict) {
+    case AdviceVerdict::kDropHandedBack: return metrics::RejectionReason::kGuardHandedBack;
+    case AdviceVerdict::kRefuseInsertionEdge: return metrics::RejectionReason::kGuardInsertionEdge;
+    case AdviceVerdict::kRefuseCooldown: return metrics::RejectionReason::kGuardCooldown;
+    case AdviceVerdict::kRefuseBusy: return metrics::RejectionReason::kGuardBusyZone;
+    case AdviceVerdict::kCarryOut: break;
+  }
+  throw std::logic_error("guardRejection: a carried-out advisory is not a rejection");
+}
+
+std::string guardRefusalDetail(AdviceVerdict verdict, const metrics::AdvisoryRequest& a) {
+  const std::string action = actionName(static_cast<Action>(a.action_code));
+  switch (verdict) {
+    case AdviceVerdict::kDropHandedBack: return action + " dropped: its zone is busy and it drives itself";
+    case AdviceVerdict::kRefuseInsertionEdge: return action + " refused on the edge where SUMO inserts traffic";
+    case AdviceVerdict::kRefuseCooldown: return action + " refused within the cooldown after its last advised change";
+    case AdviceVerdict::kRefuseBusy: return action + " refused in a busy zone";
+    case AdviceVerdict::kCarryOut: break;
+  }
+  return action;
+}
+
 using Clock = std::chrono::steady_clock;
 
 double secondsBetween(Clock::time_point a, Clock::time_point b) {
@@ -169,7 +193,6 @@ void EpisodeRunner::actuate(EpisodePort& port) {
   if (channel_.enabled())
     limits.max_step_age = std::max(limits.max_step_age, channel_.stepsWithin(channel_.params().max_advice_age_s));
   const std::uint64_t step = session_->stepCount();
-  const int lanes = session_->road().numMainLanes();
   for (const AdviceArrayPtr& array : pending_)
     if (!array->advisories.empty()) {
       run_.decision_ms.push_back(array->decision_ms);
@@ -179,28 +202,30 @@ void EpisodeRunner::actuate(EpisodePort& port) {
   std::unordered_set<std::string> advised;
   for (const AdviceInFlight& in : deliver(step)) {
     const metrics::AdvisoryRequest& a = in.array->advisories[in.index];
-    const VehicleRecord* vehicle = session_->find(a.vehicle_id);
     const metrics::AdvisoryVerdict verdict =
-        metrics::validateAdvisory(a, step, knownVehicle(vehicle, lanes), limits, advised);
+        metrics::validateAdvisory(a, step, session_->known(a.vehicle_id), limits, advised);
     if (!verdict.accepted) {
       port.rejected(in.array->rsu_id, a.vehicle_id, verdict.reason, verdict.detail);
       continue;
     }
+    AdviceVerdict carried;
     try {
-      session_->applyAdvisory(a.vehicle_id, a.action_code, a.accel_mps2);
+      carried = session_->applyAdvisory(a.vehicle_id, a.action_code, a.accel_mps2);
     } catch (const std::exception& e) {
-      // The validator and the road disagree (e.g. a lane that ends here) or SUMO refused
-      // the command: reject it and keep the simulation running.
-      port.rejected(in.array->rsu_id, a.vehicle_id, metrics::RejectionReason::kNoSuchLane, e.what());
+      // SUMO refused the command: reject it and keep the simulation running.
+      port.rejected(in.array->rsu_id, a.vehicle_id, metrics::RejectionReason::kSumoRefused, e.what());
       continue;
     }
     advised.insert(a.vehicle_id);
     // A kept advisory is a guess at the one that was lost: with keep_slowing_advice off, a
     // slowing one is not guessed on.
     const bool slows = a.action_code == static_cast<int>(Action::kAccelerate) && a.accel_mps2 < 0.0;
+    // A declined one holds too: what the guard made of it (its own lane, or its own driving)
+    // stands until the hold ends, as a carried-out one would.
     holds_.advised(a.vehicle_id, in.array->rsu_id, step, a.action_code,
                    channel_.params().keep_slowing_advice || !slows);
-    port.applied(a.vehicle_id);
+    if (carried == AdviceVerdict::kCarryOut) port.applied(a.vehicle_id);
+    else port.rejected(in.array->rsu_id, a.vehicle_id, guardRejection(carried), guardRefusalDetail(carried, a));
   }
   pending_.clear();
   for (const std::string& id :

@@ -176,6 +176,13 @@ int RoadLayout::sumoLaneIndex(const std::string& edge_id, int paper_lane) const 
   return index < e.lane_count ? index : -1;
 }
 
+int RoadLayout::mainLanesOn(const std::string& edge_id) const {
+  if (!hasEdge(edge_id) || edge(edge_id).part != RoadPart::kMainline) return num_main_lanes_;
+  int lanes = 0;
+  while (lanes < num_main_lanes_ && sumoLaneIndex(edge_id, lanes + 1) >= 0) ++lanes;
+  return std::max(lanes, 1);
+}
+
 void classifyRouteByEdges(const RoadLayout& road, const std::vector<std::string>& edges, RouteKind* kind,
                           int* entry_cluster, int* exit_cluster) {
   int entry = -1, exit = -1;

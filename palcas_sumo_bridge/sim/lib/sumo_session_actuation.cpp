@@ -84,7 +84,13 @@ void SumoSession::updateLaneChangeBound(VehicleRecord& v) {
   else boundLaneChangeAcceleration(v);
 }
 
-void SumoSession::applyAdvisory(const std::string& id, int action_code, double accel_mps2) {
+metrics::KnownVehicle SumoSession::known(const std::string& id) const {
+  const VehicleRecord* v = find(id);
+  // The lanes its edge has, never fewer than the one it is in.
+  return knownVehicle(v, v ? std::max(road_->mainLanesOn(v->edge), v->lane) : road_->numMainLanes());
+}
+
+AdviceVerdict SumoSession::applyAdvisory(const std::string& id, int action_code, double accel_mps2) {
   auto it = index_.find(id);
   if (it == index_.end()) throw std::invalid_argument("applyAdvisory: unknown vehicle '" + id + "'");
   VehicleRecord& v = vehicles_[it->second];
@@ -92,10 +98,9 @@ void SumoSession::applyAdvisory(const std::string& id, int action_code, double a
     throw std::invalid_argument("applyAdvisory: unknown action " + std::to_string(action_code));
   const Action action = static_cast<Action>(action_code);
   const bool lane_change = action == Action::kLaneLeft || action == Action::kLaneRight;
+  // The target lane was checked once, by validateAdvisory against known(id); should the road
+  // narrow before the request is issued, requestLaneChange drops it.
   const int target_lane = action == Action::kLaneLeft ? v.lane + 1 : v.lane - 1;
-  if (lane_change && road_->hasEdge(v.edge) && road_->sumoLaneIndex(v.edge, target_lane) < 0)
-    throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' on edge '" + v.edge +
-                                "' has no lane " + std::to_string(target_lane));
   if (action == Action::kAccelerate && !std::isfinite(accel_mps2))
     throw std::invalid_argument("applyAdvisory: vehicle '" + id + "' got acceleration " +
                                 std::to_string(accel_mps2));
@@ -111,11 +116,11 @@ void SumoSession::applyAdvisory(const std::string& id, int action_code, double a
   if (verdict == AdviceVerdict::kDropHandedBack) {
     // Its zone is busy: it drives itself, route and lane changes included.
     v.command = HeldCommand::kNone;
-    return;
+    return verdict;
   }
   if (verdict != AdviceVerdict::kCarryOut) {  // a refused change: it keeps its lane, as under KEEP
     holdOwnDriving(v);
-    return;
+    return verdict;
   }
   if (lane_change) {
     v.lane_change_target = target_lane;
@@ -133,6 +138,7 @@ void SumoSession::applyAdvisory(const std::string& id, int action_code, double a
   } else {  // KEEP
     holdOwnDriving(v);
   }
+  return verdict;
 }
 
 void SumoSession::endCommand(const std::string& id) {

@@ -22,12 +22,13 @@ using palcas::sim::EpisodePort;
 using palcas::sim::EpisodeRun;
 using palcas::sim::EpisodeRunner;
 using palcas::sim::RunnerOptions;
+using palcas::sim::SessionOptions;
 using palcas::sim::SumoSession;
 using palcas::sim::VehicleRecord;
 
 namespace {
 
-constexpr int LANE_LEFT = 0, ACCELERATE = 2, KEEP = 3;
+constexpr int LANE_LEFT = 0, LANE_RIGHT = 1, ACCELERATE = 2, KEEP = 3;
 
 // The RSUs of a test: called once per published step with the runner to answer through.
 using Rsus = std::function<void(const SumoSession&, EpisodeRunner&)>;
@@ -214,6 +215,44 @@ TEST(EpisodeRunner, ChecksAdvisoriesCarriesOutTheGoodOnesAndHoldsThem) {
   EXPECT_EQ(port.in_force_by_step.at(advised_step + 10), 0u);
   EXPECT_EQ(run.downlink.sent, 5u);
   EXPECT_EQ(run.downlink.delivered, 5u);  // the channel is off: everything arrives at once
+}
+
+TEST(EpisodeRunner, AnAdvisoryTheGuardDeclinesIsARejectionWithTheGuardsReason) {
+  // Lane changes advised on the edge where SUMO inserts traffic, every second: valid advice
+  // the guard declines. Each is reported as a rejection naming the guard's rule, never as
+  // carried out, and the count is the guard's own.
+  EpisodeRunner runner(tinyRunner({"rsu_0"}, 60.0), [](int episode) {
+    SessionOptions o = palcas::sim::test::sessionOnTiny("runner_guard" + std::to_string(episode), 11, 2000.0);
+    o.guard.insertion_edge = true;
+    o.guard.busy_speed_share = 0.0;  // busy zones would hand the CAVs back: this is about insertion
+    o.guard.busy_leave_share = 0.0;
+    return std::make_unique<SumoSession>(o);
+  });
+  std::string reason;
+  ASSERT_TRUE(runner.lockstep().registerRsu("rsu_0", &reason));
+  std::size_t advised = 0;
+  ScriptedPort port(runner, [&](const SumoSession& s, EpisodeRunner& r) {
+    auto array = answer("rsu_0", s.stepCount());
+    if (s.stepCount() % 10 == 0)
+      for (const VehicleRecord& v : s.vehicles())
+        if (v.is_cav && v.edge == "main_0_warmup" && v.lane >= 1 && v.lane_change_target == 0) {
+          advise(*array, v.id, v.lane < 3 ? LANE_LEFT : LANE_RIGHT);
+          ++advised;
+        }
+    r.onAnswer(array);
+  });
+  runner.runEpisode(0, port);
+  ASSERT_GT(advised, 20u) << "too few CAVs on the warm-up edge";
+  const int declined = port.rejections[RejectionReason::kGuardInsertionEdge];
+  EXPECT_GT(declined, 0);
+  EXPECT_EQ(static_cast<std::uint64_t>(declined), runner.session().guardCounters().lane_changes_insertion_refused);
+  EXPECT_NE(port.last_rejection.find("where SUMO inserts traffic"), std::string::npos) << port.last_rejection;
+  std::size_t applied = 0;
+  for (const auto& [id, steps] : port.applied_at) applied += steps.size();
+  std::size_t rejected = 0;
+  for (const auto& [why, n] : port.rejections) rejected += static_cast<std::size_t>(n);
+  EXPECT_EQ(applied + rejected, advised) << "every advisory is carried out or rejected, once";
+  EXPECT_EQ(port.rejections[RejectionReason::kNoSuchLane], 0) << "the tiny road's 3 lanes all exist on the warm-up edge";
 }
 
 namespace {

@@ -124,6 +124,12 @@ TEST(OwnRoad, LayoutMapsLanesAndPositionsAndZones) {
   EXPECT_EQ(layout.sumoLaneIndex("narrow", 4), 3);
   EXPECT_EQ(layout.sumoLaneIndex("narrow", 5), -1);
   EXPECT_EQ(layout.sumoLaneIndex("straight", 5), 4);
+  // The lanes an advisory may target there: the validator's one lane check.
+  EXPECT_EQ(layout.mainLanesOn("narrow"), 4);
+  EXPECT_EQ(layout.mainLanesOn("straight"), 5);
+  EXPECT_EQ(layout.mainLanesOn("weave"), 5);
+  EXPECT_EQ(layout.mainLanesOn("slip_in"), 5);
+  EXPECT_EQ(layout.mainLanesOn("no_such_edge"), 5);
   EXPECT_EQ(layout.paperLane("slip_in", 0), 0);
   // x: edge offset + lane position; a ramp vehicle counts down to where it joins.
   const EdgeInfo& bend = layout.edge("bend");

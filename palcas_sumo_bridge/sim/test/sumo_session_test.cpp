@@ -104,13 +104,24 @@ TEST(SumoSession, AdvisedLaneChangeHappensAndBadAdvisoriesAreRefused) {
   }
   EXPECT_TRUE(merged) << "no ramp CAV merged by itself";
 
-  // 4. Advisories the session cannot apply are refused, naming the problem.
+  // 4. Advisories the session cannot apply are refused, naming the problem. A lane that
+  // does not exist is the validator's to refuse, against what the session knows of the CAV.
   EXPECT_THROW(session.applyAdvisory("no_such_vehicle", KEEP, 0.0), std::invalid_argument);
+  EXPECT_FALSE(session.known("no_such_vehicle").exists);
+  bool leftmost_seen = false;
   for (const VehicleRecord& v : session.vehicles())
     if (v.part == RoadPart::kMainline && v.lane == 3 && session.road().hasEdge(v.edge)) {
-      EXPECT_THROW(session.applyAdvisory(v.id, LANE_LEFT, 0.0), std::invalid_argument) << v.id;
+      palcas::metrics::AdvisoryRequest left;
+      left.vehicle_id = v.id;
+      left.action_code = LANE_LEFT;
+      left.answers_step = session.stepCount();
+      const auto verdict = palcas::metrics::validateAdvisory(left, session.stepCount(), session.known(v.id), {}, {});
+      EXPECT_FALSE(verdict.accepted) << v.id;
+      EXPECT_EQ(verdict.reason, palcas::metrics::RejectionReason::kNoSuchLane) << verdict.detail;
+      leftmost_seen = true;
       break;
     }
+  EXPECT_TRUE(leftmost_seen) << "no mainline vehicle in lane 3";
   EXPECT_THROW(session.applyAdvisory(session.vehicles().front().id, 9, 0.0), std::invalid_argument);
   // A NaN acceleration is refused and the vehicle keeps the command it held.
   const std::string first = session.vehicles().front().id;

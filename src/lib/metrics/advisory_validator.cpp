@@ -77,8 +77,18 @@ std::string rejectionReasonName(RejectionReason reason) {
     case RejectionReason::kUnknownAction: return "unknown_action";
     case RejectionReason::kDuplicate: return "duplicate";
     case RejectionReason::kUnauthenticated: return "unauthenticated";
+    case RejectionReason::kGuardHandedBack: return "guard_handed_back";
+    case RejectionReason::kGuardInsertionEdge: return "guard_insertion_edge";
+    case RejectionReason::kGuardCooldown: return "guard_cooldown";
+    case RejectionReason::kGuardBusyZone: return "guard_busy_zone";
+    case RejectionReason::kSumoRefused: return "sumo_refused";
   }
   return "unknown";
+}
+
+bool isGuardRefusal(RejectionReason reason) {
+  return reason == RejectionReason::kGuardHandedBack || reason == RejectionReason::kGuardInsertionEdge ||
+         reason == RejectionReason::kGuardCooldown || reason == RejectionReason::kGuardBusyZone;
 }
 
 AdvisoryVerdict validateAdvisory(const AdvisoryRequest& advisory, std::uint64_t current_step,

@@ -157,7 +157,12 @@ TEST(AdvisoryValidator, ReasonCodesMatchAdvisoryRejectionMsg) {
       {"STALE_STEP", RejectionReason::kStaleStep},
       {"UNKNOWN_ACTION", RejectionReason::kUnknownAction},
       {"DUPLICATE", RejectionReason::kDuplicate},
-      {"UNAUTHENTICATED", RejectionReason::kUnauthenticated}};
+      {"UNAUTHENTICATED", RejectionReason::kUnauthenticated},
+      {"GUARD_HANDED_BACK", RejectionReason::kGuardHandedBack},
+      {"GUARD_INSERTION_EDGE", RejectionReason::kGuardInsertionEdge},
+      {"GUARD_COOLDOWN", RejectionReason::kGuardCooldown},
+      {"GUARD_BUSY_ZONE", RejectionReason::kGuardBusyZone},
+      {"SUMO_REFUSED", RejectionReason::kSumoRefused}};
   for (const auto& [name, reason] : expected) {
     ASSERT_EQ(msg.count(name), 1u) << name;
     EXPECT_EQ(msg.at(name), static_cast<int>(reason)) << name;
@@ -169,4 +174,15 @@ TEST(AdvisoryValidator, ReasonCodesMatchAdvisoryRejectionMsg) {
   ASSERT_EQ(msg.count("REASON_COUNT"), 1u);
   EXPECT_EQ(msg.at("REASON_COUNT"), REJECTION_REASON_COUNT);
   EXPECT_EQ(msg.size(), expected.size() + 1);
+}
+
+TEST(AdvisoryValidator, GuardRefusalsAreTheGuardsFourReasons) {
+  int guard = 0;
+  for (int code = 0; code < REJECTION_REASON_COUNT; ++code) {
+    const auto reason = static_cast<RejectionReason>(code);
+    const bool by_guard = isGuardRefusal(reason);
+    guard += by_guard;
+    EXPECT_EQ(by_guard, rejectionReasonName(reason).rfind("guard_", 0) == 0) << rejectionReasonName(reason);
+  }
+  EXPECT_EQ(guard, 4);
 }

@@ -34,9 +34,6 @@ struct AdviceArray {
 };
 using AdviceArrayPtr = std::shared_ptr<const AdviceArray>;
 
-/// What the validator knows of a vehicle (null: not on the road).
-metrics::KnownVehicle knownVehicle(const VehicleRecord* record, int num_lanes);
-
 /// Cost per step against the number of vehicles on the road, in buckets of 50 vehicles:
 /// SUMO's own step (with reading the subscriptions), the bridge's work around it
 /// (conversion, publishing, measuring) and the lockstep (waiting for the RSUs' answers and

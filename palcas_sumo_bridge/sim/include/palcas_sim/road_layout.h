@@ -87,6 +87,9 @@ class RoadLayout {
   /// SUMO lane index on `edge_id` of paper lane `lane` (1..L), or -1 if the edge has no
   /// such lane.
   int sumoLaneIndex(const std::string& edge_id, int paper_lane) const;
+  /// Paper lanes 1..n a mainline edge has (fewer than L where a lane ends); L for any other
+  /// edge or one the road does not place (a junction: the request waits for the next edge).
+  int mainLanesOn(const std::string& edge_id) const;
 
  private:
   /// Zones of cluster_length_m_ over the mainline with the ramps and merge edges of `edges_`.

@@ -13,6 +13,7 @@
 
 #include "palcas_core/common/action.h"
 #include "palcas_core/common/road_terms.h"
+#include "palcas_core/metrics/advisory_validator.h"
 #include "palcas_sim/advice_guard.h"
 #include "palcas_sim/own_road.h"
 #include "palcas_sim/road_layout.h"
@@ -156,6 +157,10 @@ struct StepEvents {
   std::vector<VehicleRecord> removed;
 };
 
+/// What the validator knows of a vehicle (null: not on the road) with `num_lanes` mainline
+/// lanes at its position (SumoSession::known gives the lanes of its edge).
+metrics::KnownVehicle knownVehicle(const VehicleRecord* record, int num_lanes);
+
 class SumoSession {
  public:
   /// Starts SUMO and reads the network. @throws std::runtime_error with SUMO's message
@@ -186,13 +191,17 @@ class SumoSession {
   /// nullptr when no such vehicle is on the road.
   const VehicleRecord* find(const std::string& id) const;
 
-  /// Applies an already validated advisory (`action_code`: a palcas::Action code, as
-  /// palcas_msgs/Advisory carries it) to a CAV: lane changes go through SUMO's changeLane for
-  /// lane_change_duration_s while the speed is held; ACCELERATE holds `accel_mps2`; KEEP holds
-  /// the current speed.
-  /// @throws std::invalid_argument for an unknown vehicle, an unknown action code, a lane
-  /// that does not exist or a non-finite acceleration.
-  void applyAdvisory(const std::string& id, int action_code, double accel_mps2);
+  /// What the advisory validator needs to know of vehicle `id` (exists = false when it is not
+  /// on the road), its lane count the lanes its edge has: the trip's one lane check.
+  metrics::KnownVehicle known(const std::string& id) const;
+  /// Applies an advisory validateAdvisory accepted against known(id) (`action_code`: a
+  /// palcas::Action code, as palcas_msgs/Advisory carries it) to a CAV, as the advice guard
+  /// allows: lane changes go through SUMO's changeLane for lane_change_duration_s while the
+  /// speed is held; ACCELERATE holds `accel_mps2`; KEEP holds the current speed. Returns the
+  /// guard's verdict (kCarryOut: done as advised; otherwise declined, and why).
+  /// @throws std::invalid_argument for an unknown vehicle, an unknown action code or a
+  /// non-finite acceleration.
+  AdviceVerdict applyAdvisory(const std::string& id, int action_code, double accel_mps2);
   /// The command of a controlled CAV ended (expired, or its RSU is late or lost): with
   /// own_car_following SUMO's model drives it again, else it keeps its current speed (not on
   /// an off-ramp, where SUMO drives it again). Unknown ids are ignored.

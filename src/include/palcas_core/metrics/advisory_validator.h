@@ -22,11 +22,23 @@ enum class RejectionReason : int {
   /// The whole array's authentication tag is missing or wrong (palcas_core/common/message_auth.h):
   /// counted once per array, before any of its advisories is looked at.
   kUnauthenticated = 8,
+  // A valid advisory the advice guard did not carry out (palcas_sim/advice_guard.h): counted
+  // and published like the rules above, so one count says what became of every advisory.
+  kGuardHandedBack = 9,     ///< its zone is busy: the CAV drives itself, no advice is carried out
+  kGuardInsertionEdge = 10, ///< a lane change on the edge where SUMO inserts traffic
+  kGuardCooldown = 11,      ///< a lane change moments after its last advised one
+  kGuardBusyZone = 12,      ///< a lane change in a busy zone (hand-back off)
+  /// SUMO refused the command (libsumo threw): the simulation goes on without it.
+  kSumoRefused = 13,
 };
-constexpr int REJECTION_REASON_COUNT = 9;
+constexpr int REJECTION_REASON_COUNT = 14;
 
-/// Name used in logs and JSON ("unknown_vehicle", ..., "unauthenticated"); "unknown" otherwise.
+/// Name used in logs and JSON ("unknown_vehicle", ..., "sumo_refused"); "unknown" otherwise.
 std::string rejectionReasonName(RejectionReason reason);
+
+/// True for the guard's refusals: the advisory was valid, the road's state declined it. They
+/// are expected in every run with the guard on, so the bridge logs them at debug level only.
+bool isGuardRefusal(RejectionReason reason);
 
 /// One advisory as received (mirrors palcas_msgs/Advisory plus its AdvisoryArray's step/rsu).
 struct AdvisoryRequest {
@@ -43,7 +55,9 @@ struct KnownVehicle {
   bool is_cav = false;
   int lane = 1;                 ///< paper lane 1..num_lanes; 0 = ramp, accel lane or off-ramp
   bool on_accel_lane = false;   ///< on an acceleration lane (then lane == 0)
-  int num_lanes = 5;            ///< mainline lanes L at its position
+  /// Mainline lanes at its position: the lanes its edge has (fewer than the road's L where a
+  /// lane ends), so this is the trip's one lane check.
+  int num_lanes = 5;
 };
 
 /// Acceptance limits.
