@@ -47,6 +47,8 @@ sim::ScenarioConfig loadScenario(palcas::common::ParamReader& p, const ros::Node
                              std::pair{"speed_limit_mps", &r.speed_limit_mps},
                              std::pair{"ramp_speed_limit_mps", &r.ramp_speed_limit_mps}})
     *value = p.number(std::string("scenario/road/") + name, *value, 1e-3, 1e6);
+  r.zone_starts_m = p.get<std::vector<double>>("scenario/road/zone_starts_m", r.zone_starts_m);
+  r.zone_start_edges = p.get<std::vector<std::string>>("scenario/road/zone_start_edges", r.zone_start_edges);
   c.generate_network = p.get<bool>("scenario/generate_network", c.generate_network);
   c.network_file = p.get<std::string>("scenario/network_file", c.network_file);
   c.mainline_edges = p.get<std::vector<std::string>>("scenario/mainline_edges", c.mainline_edges);

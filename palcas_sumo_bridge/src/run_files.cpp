@@ -83,7 +83,9 @@ json scenarioJson(const sim::ScenarioConfig& c) {
                      {"exit_m", r.exit_m},
                      {"lane_width_m", r.lane_width_m},
                      {"speed_limit_mps", r.speed_limit_mps},
-                     {"ramp_speed_limit_mps", r.ramp_speed_limit_mps}};
+                     {"ramp_speed_limit_mps", r.ramp_speed_limit_mps},
+                     {"zone_starts_m", r.zone_starts_m},
+                     {"zone_start_edges", r.zone_start_edges}};
   return {{"scenario_dir", c.scenario_dir},
           {"road", road},
           {"generate_network", c.generate_network},

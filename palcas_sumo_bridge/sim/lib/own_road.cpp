@@ -3,6 +3,7 @@
 #include "palcas_sim/own_road.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -197,6 +198,60 @@ NetTopology readNetTopology(const std::string& net_file) {
   return net;
 }
 
+namespace {
+
+std::string metres(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
+/// Where each zone starts along a mainline of `length_m`: equal parts, or the user's x or edges.
+std::vector<double> zoneStarts(const OwnRoadOptions& o, const std::vector<std::string>& mainline,
+                               std::map<std::string, EdgeInfo>& info, double length_m) {
+  std::vector<double> starts;
+  if (!o.zone_starts_m.empty() && !o.zone_start_edges.empty())
+    throw std::invalid_argument("road/zone_starts_m and road/zone_start_edges both given: say where the zones "
+                                "start one way");
+  const std::size_t given = o.zone_starts_m.empty() ? o.zone_start_edges.size() : o.zone_starts_m.size();
+  if (given == 0) {
+    for (int k = 0; k < o.clusters; ++k) starts.push_back(k * length_m / o.clusters);
+    return starts;
+  }
+  const std::string key = o.zone_starts_m.empty() ? "road/zone_start_edges" : "road/zone_starts_m";
+  if (given != static_cast<std::size_t>(o.clusters))
+    throw std::invalid_argument(key + " lists " + std::to_string(given) + " zones but road/clusters is " +
+                                std::to_string(o.clusters) + ": set road/clusters to " + std::to_string(given));
+  for (std::size_t k = 0; k < given; ++k) {
+    const std::string at = key + "[" + std::to_string(k) + "]";
+    double x = 0.0;
+    if (o.zone_starts_m.empty()) {
+      const std::string& id = o.zone_start_edges[k];
+      if (std::find(mainline.begin(), mainline.end(), id) == mainline.end())
+        throw std::invalid_argument(at + " '" + id + "' is not a mainline edge (the mainline: " + joined(mainline) +
+                                    ")");
+      x = info[id].x_start_m;
+      if (k == 0 && id != mainline.front())
+        throw std::invalid_argument(at + " '" + id + "': zone 0 starts where the mainline does, at '" +
+                                    mainline.front() + "'");
+    } else {
+      x = o.zone_starts_m[k];
+      if (k == 0 && x != 0.0)
+        throw std::invalid_argument(at + " = " + metres(x) + " m: zone 0 starts where the mainline does, at 0");
+    }
+    if (k > 0 && !(x > starts.back()))
+      throw std::invalid_argument(at + " starts at " + metres(x) + " m, not after the zone before it (" +
+                                  metres(starts.back()) + " m): zones are listed in driving order");
+    if (!(x < length_m))
+      throw std::invalid_argument(at + " starts at " + metres(x) + " m, past the mainline's end (" +
+                                  metres(length_m) + " m)");
+    starts.push_back(x);
+  }
+  return starts;
+}
+
+}  // namespace
+
 OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options) {
   if (options.clusters < 1)
     throw std::invalid_argument("road/clusters must be >= 1, got " + std::to_string(options.clusters));
@@ -229,8 +284,10 @@ OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options) {
   road.mainline_length_m = x;
   if (!(x > 0.0)) throw std::invalid_argument("the mainline (" + joined(road.mainline) + ") has length 0");
   road.cluster_length_m = x / options.clusters;
+  road.zone_starts_m = zoneStarts(options, road.mainline, info, x);
   const auto zoneOf = [&](double at_m) {
-    return std::clamp(static_cast<int>(std::floor(at_m / road.cluster_length_m)), 0, options.clusters - 1);
+    const auto after = std::upper_bound(road.zone_starts_m.begin(), road.zone_starts_m.end(), at_m);
+    return std::max(0, static_cast<int>(after - road.zone_starts_m.begin()) - 1);
   };
   // Every junction-internal lane leaving a mainline edge starts where that edge ends.
   for (const std::string& id : road.mainline)
@@ -287,7 +344,7 @@ OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options) {
       auto [it, fresh] = on_ramp_of_zone.emplace(r.cluster, id);
       if (!fresh)
         throw std::invalid_argument("zone " + std::to_string(r.cluster) + " has two on-ramps ('" + it->second +
-                                    "' and '" + id + "'): one per zone is supported; change road/clusters");
+                                    "' and '" + id + "'): one per zone is supported; change road/clusters or say where the zones start (road/zone_starts_m)");
       road.on_ramp_joins_edge[r.cluster] = into->to_edge;
       // The acceleration lane it feeds belongs to its zone, over every edge it spans.
       for (auto m = std::find(road.mainline.begin(), road.mainline.end(), into->to_edge);
@@ -310,7 +367,7 @@ OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options) {
       auto [it, fresh] = off_ramp_of_zone.emplace(r.cluster, id);
       if (!fresh)
         throw std::invalid_argument("zone " + std::to_string(r.cluster) + " has two off-ramps ('" + it->second +
-                                    "' and '" + id + "'): one per zone is supported; change road/clusters");
+                                    "' and '" + id + "'): one per zone is supported; change road/clusters or say where the zones start (road/zone_starts_m)");
       road.exit_from_edge[r.cluster] = from.id;
     }
     road.edges.push_back(r);

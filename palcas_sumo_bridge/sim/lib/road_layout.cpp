@@ -56,7 +56,9 @@ RoadLayout::RoadLayout(std::vector<EdgeInfo> edges, int num_main_lanes, double c
     if (e.part == RoadPart::kMainline) main.push_back(&e);
   std::sort(main.begin(), main.end(), [](const EdgeInfo* a, const EdgeInfo* b) { return a->x_start_m < b->x_start_m; });
   for (const EdgeInfo* e : main) mainline_.push_back(e->id);
-  buildClusters(cluster_count);
+  std::vector<double> starts;
+  for (int k = 0; k < cluster_count; ++k) starts.push_back(k * cluster_length_m_);
+  buildClusters(starts);
   for (const ClusterInfo& c : clusters_)
     if (!c.on_ramp_edge.empty() && c.merge_edge.empty())
       throw std::invalid_argument("RoadLayout: cluster " + std::to_string(c.index) +
@@ -70,7 +72,10 @@ RoadLayout::RoadLayout(const OwnRoad& road)
   if (mainline_.empty() || !(cluster_length_m_ > 0.0) || num_main_lanes_ < 1)
     throw std::invalid_argument("RoadLayout: the road has no mainline");
   for (std::size_t i = 0; i < edges_.size(); ++i) index_[edges_[i].id] = i;
-  buildClusters(road.clusters);
+  if (static_cast<int>(road.zone_starts_m.size()) != road.clusters)
+    throw std::invalid_argument("RoadLayout: the road has " + std::to_string(road.clusters) + " zones but " +
+                                std::to_string(road.zone_starts_m.size()) + " zone starts");
+  buildClusters(road.zone_starts_m);
   for (const auto& [zone, edge_id] : road.exit_from_edge) {
     // The exit is where the mainline edge it leaves from ends (its ramp starts after the
     // junction lane).
@@ -85,14 +90,15 @@ RoadLayout::RoadLayout(const OwnRoad& road)
   }
 }
 
-void RoadLayout::buildClusters(int cluster_count) {
+void RoadLayout::buildClusters(const std::vector<double>& zone_starts_m) {
+  const int cluster_count = static_cast<int>(zone_starts_m.size());
   clusters_.resize(cluster_count);
   for (int k = 0; k < cluster_count; ++k) {
     clusters_[k].index = k;
-    clusters_[k].x_start_m = k * cluster_length_m_;
-    clusters_[k].x_end_m = k + 1 == cluster_count && measured_along_lanes_
-                               ? mainline_length_m_
-                               : std::min((k + 1) * cluster_length_m_, mainline_length_m_);
+    clusters_[k].x_start_m = zone_starts_m[k];
+    clusters_[k].x_end_m = k + 1 < cluster_count ? zone_starts_m[k + 1]
+                           : measured_along_lanes_ ? mainline_length_m_
+                                                   : std::min((k + 1) * cluster_length_m_, mainline_length_m_);
   }
   for (const EdgeInfo& e : edges_) {
     if (e.cluster < 0) continue;
@@ -148,8 +154,9 @@ const EdgeInfo& RoadLayout::edge(const std::string& id) const {
 }
 
 int RoadLayout::clusterAt(double x_m) const {
-  const int k = static_cast<int>(std::floor(x_m / cluster_length_m_));
-  return std::clamp(k, 0, static_cast<int>(clusters_.size()) - 1);
+  const auto after = std::upper_bound(clusters_.begin(), clusters_.end(), x_m,
+                                      [](double x, const ClusterInfo& c) { return x < c.x_start_m; });
+  return std::max(0, static_cast<int>(after - clusters_.begin()) - 1);
 }
 
 int RoadLayout::zoneAt(double x_m) const {

@@ -204,6 +204,42 @@ void validateRoadZones(const RoadSpec& r) {
   requireInRange(r.cluster_length_m, 0.0, MAX_CLUSTER_LENGTH_M, "cluster_length_m");
 }
 
+void validateZoneStarts(const RoadSpec& r) {
+  if (!r.zone_starts_m.empty() && !r.zone_start_edges.empty())
+    throw std::invalid_argument("road/zone_starts_m and road/zone_start_edges both given: say where the zones "
+                                "start one way");
+  const bool by_x = !r.zone_starts_m.empty();
+  const std::size_t given = by_x ? r.zone_starts_m.size() : r.zone_start_edges.size();
+  if (given == 0) return;
+  const std::string key = by_x ? "zone_starts_m" : "zone_start_edges";
+  if (given != static_cast<std::size_t>(r.clusters))
+    throw std::invalid_argument("road/" + key + " lists " + std::to_string(given) + " zones but road/clusters is " +
+                                std::to_string(r.clusters) + ": set road/clusters to " + std::to_string(given));
+  for (std::size_t k = 0; k < given; ++k) {
+    const std::string at = "road/" + key + "[" + std::to_string(k) + "]";
+    if (!by_x) {
+      if (r.zone_start_edges[k].empty()) throw std::invalid_argument(at + " is an empty edge id");
+      for (std::size_t j = 0; j < k; ++j)
+        if (r.zone_start_edges[j] == r.zone_start_edges[k])
+          throw std::invalid_argument(at + " '" + r.zone_start_edges[k] + "' starts zone " + std::to_string(j) +
+                                      " already");
+      continue;
+    }
+    const double x = r.zone_starts_m[k];
+    if (k == 0 && x != 0.0)
+      throw std::invalid_argument(at + " = " + num(x) + " m: zone 0 starts where the mainline does, at 0");
+    if (k > 0 && !(x >= r.zone_starts_m[k - 1] + MIN_EDGE_M))
+      throw std::invalid_argument(at + " = " + num(x) + " m must be at least " + num(MIN_EDGE_M) +
+                                  " m after the zone before it (" + num(r.zone_starts_m[k - 1]) + " m)");
+  }
+}
+
+void refuseZoneStarts(const RoadSpec& r) {
+  if (!r.zone_starts_m.empty() || !r.zone_start_edges.empty())
+    throw std::invalid_argument(std::string("road/") + (r.zone_starts_m.empty() ? "zone_start_edges" : "zone_starts_m") +
+                                " is only read with network_file: this road's zones are its clusters");
+}
+
 void validateRoadLanes(const RoadSpec& r) {
   if (r.num_lanes < 1 || r.num_lanes > MAX_LANES)
     bad("num_lanes", std::to_string(r.num_lanes), "must be in [1, " + std::to_string(MAX_LANES) + "]");
@@ -212,6 +248,7 @@ void validateRoadLanes(const RoadSpec& r) {
 }  // namespace detail
 
 void validateRoadSpec(const RoadSpec& r) {
+  detail::refuseZoneStarts(r);
   detail::validateRoadZones(r);
   detail::validateRoadLanes(r);
   requireInRange(r.lane_width_m, 0.0, MAX_LANE_WIDTH_M, "lane_width_m");

@@ -160,6 +160,7 @@ void validateScenarioConfig(const ScenarioConfig& c) {
   if (c.scenario_dir.empty()) throw std::invalid_argument("ScenarioConfig.scenario_dir is empty");
   if (!c.network_file.empty()) {  // an own road: its zone count and lane count
     detail::validateRoadZones(c.road);
+    detail::validateZoneStarts(c.road);
     detail::validateRoadLanes(c.road);
     for (const std::string& id : c.mainline_edges)
       if (id.empty()) throw std::invalid_argument("ScenarioConfig.mainline_edges has an empty edge id");
@@ -169,6 +170,7 @@ void validateScenarioConfig(const ScenarioConfig& c) {
   } else if (c.generate_network) {
     validateRoadSpec(c.road);
   } else {  // a hand-written network: only what describes any road of the naming convention
+    detail::refuseZoneStarts(c.road);
     detail::validateRoadZones(c.road);
     detail::validateRoadLanes(c.road);
   }
@@ -264,6 +266,8 @@ OwnRoadOptions ownRoadOptions(const ScenarioConfig& c) {
   OwnRoadOptions o;
   o.mainline_edges = c.mainline_edges;
   o.clusters = c.road.clusters;
+  o.zone_starts_m = c.road.zone_starts_m;
+  o.zone_start_edges = c.road.zone_start_edges;
   return o;
 }
 

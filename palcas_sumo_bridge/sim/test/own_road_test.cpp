@@ -293,6 +293,81 @@ TEST(OwnRoad, ThreeRampsEachInTheZoneOfItsJunction) {
   EXPECT_EQ(exit, -1);
 }
 
+TEST(OwnRoad, ZonesStartWhereTheUserSays) {
+  // Three zones in equal thirds put the harbour and the mall entries both in zone 0: refused.
+  // Where an operator would stand the three RSUs, one per junction pair, they fit, given as
+  // edges or as x.
+  ScenarioConfig c = threeRampsConfig();
+  c.road.clusters = 3;
+  const ScenarioFiles files = writeScenario(threeRampsConfig(), freshDir("own_road_zone_starts"));
+  const NetTopology net = readNetTopology(files.net_file);
+  EXPECT_THROW_NAMING(discoverOwnRoad(net, ownRoadOptions(c)), std::invalid_argument,
+                      "zone 0 has two on-ramps ('entry_harbour' and 'entry_mall')");
+  c.road.zone_start_edges = {"A1_west", "A1_harbour_mall", "A1_mall_park"};
+  const OwnRoad by_edge = discoverOwnRoad(net, ownRoadOptions(c));
+  const RoadLayout road(by_edge);
+  ASSERT_EQ(road.clusters().size(), 3u);
+  std::vector<std::string> on, off;
+  for (const ClusterInfo& k : road.clusters()) {
+    on.push_back(k.on_ramp_edge);
+    off.push_back(k.off_ramp_edge);
+  }
+  EXPECT_EQ(on, (std::vector<std::string>{"entry_harbour", "entry_mall", "entry_park"}));
+  EXPECT_EQ(off, (std::vector<std::string>{"off_1", "off_2", "off_3"}));
+  const double mall_start = edgeOf(by_edge, "A1_harbour_mall").x_start_m;
+  const double park_start = edgeOf(by_edge, "A1_mall_park").x_start_m;
+  EXPECT_DOUBLE_EQ(road.clusters()[0].x_start_m, 0.0);
+  EXPECT_DOUBLE_EQ(road.clusters()[0].x_end_m, mall_start);
+  EXPECT_DOUBLE_EQ(road.clusters()[1].x_start_m, mall_start);
+  EXPECT_DOUBLE_EQ(road.clusters()[2].x_start_m, park_start);
+  EXPECT_DOUBLE_EQ(road.clusters()[2].x_end_m, road.mainlineLengthM());
+  // The one zone lookup follows: the last metre before a start is the zone before it.
+  EXPECT_EQ(road.zoneAt(mall_start - 1.0), 0);
+  EXPECT_EQ(road.zoneAt(mall_start), 1);
+  EXPECT_EQ(road.zoneAt(park_start + 1.0), 2);
+  EXPECT_EQ(road.clusterAt(road.mainlineLengthM() + 50.0), 2);
+  // The same zones by x.
+  c.road.zone_start_edges.clear();
+  c.road.zone_starts_m = {0.0, mall_start, park_start};
+  EXPECT_EQ(discoverOwnRoad(net, ownRoadOptions(c)).zone_starts_m, by_edge.zone_starts_m);
+  // And through the scenario, routes included.
+  EXPECT_NO_THROW(writeScenario(c, freshDir("own_road_zone_starts_x")));
+}
+
+TEST(OwnRoad, ZoneStartsThatDoNotFitAreRefusedNamingTheKey) {
+  const ScenarioFiles files = writeScenario(threeRampsConfig(), freshDir("own_road_zone_starts_bad"));
+  const NetTopology net = readNetTopology(files.net_file);
+  ScenarioConfig c = threeRampsConfig();
+  c.road.clusters = 3;
+  const auto refused = [&](const std::vector<double>& x, const std::vector<std::string>& edges, const char* needle) {
+    ScenarioConfig bad = c;
+    bad.road.zone_starts_m = x;
+    bad.road.zone_start_edges = edges;
+    EXPECT_THROW_NAMING(discoverOwnRoad(net, ownRoadOptions(bad)), std::invalid_argument, needle);
+  };
+  refused({0.0, 1000.0}, {}, "road/zone_starts_m lists 2 zones but road/clusters is 3: set road/clusters to 2");
+  refused({5.0, 1000.0, 2000.0}, {}, "road/zone_starts_m[0] = 5");
+  refused({0.0, 2000.0, 1000.0}, {}, "road/zone_starts_m[2] starts at 1000");
+  refused({0.0, 1000.0, 3500.0}, {}, "past the mainline's end");
+  refused({}, {"A1_west", "off_2", "A1_mall_park"}, "road/zone_start_edges[1] 'off_2' is not a mainline edge");
+  refused({}, {"A1_harbour", "A1_mall", "A1_park"}, "zone 0 starts where the mainline does, at 'A1_west'");
+  refused({0.0, 1000.0, 2000.0}, {"A1_west", "A1_mall", "A1_park"}, "both given");
+  // The scenario's own check, before any network is read, names the same keys.
+  ScenarioConfig bad = c;
+  bad.road.zone_starts_m = {0.0, 1000.0, 1000.5};
+  EXPECT_THROW_NAMING(validateScenarioConfig(bad), std::invalid_argument,
+                      "road/zone_starts_m[2] = 1000.5 m must be at least 1 m after");
+  bad.road.zone_starts_m.clear();
+  bad.road.zone_start_edges = {"A1_west", "A1_mall", "A1_mall"};
+  EXPECT_THROW_NAMING(validateScenarioConfig(bad), std::invalid_argument, "'A1_mall' starts zone 1 already");
+  // A road of the naming convention: its zones are its clusters.
+  ScenarioConfig generated;
+  generated.scenario_dir = scenarioDir("tiny");
+  generated.road.zone_starts_m = {0.0, 400.0, 1200.0};
+  EXPECT_THROW_NAMING(validateScenarioConfig(generated), std::invalid_argument,
+                      "road/zone_starts_m is only read with network_file");
+}
+
 // Hand-made topologies for the rule's corner cases (no netconvert needed).
 NetTopology straightRoad(const std::vector<std::tuple<std::string, std::string, std::string, int>>& edges,
                          const std::vector<std::pair<std::string, std::string>>& links) {

@@ -17,8 +17,9 @@
 //              feed (no through lane of the edge before it);
 //   lanes      paper lane 1 = the rightmost through lane; L = the most through lanes of any
 //              mainline edge (an edge with fewer has no lanes above its count: a lane drop);
-//   zones      the mainline split into `clusters` equal zones; a ramp belongs to the zone
-//              holding its junction; at most one on-ramp and one off-ramp per zone;
+//   zones      the mainline split into `clusters` equal zones, or starting where the user
+//              says (x or mainline edges: where the roadside units stand); a ramp belongs to
+//              the zone holding its junction; at most one on-ramp and one off-ramp per zone;
 //   junction   the junction-internal edges from the mainline onto an off-ramp belong to that
 //              off-ramp (its exit is judged on them: metrics.md, "OutcomeTracker rules").
 
@@ -63,6 +64,10 @@ NetTopology readNetTopology(const std::string& net_file);
 struct OwnRoadOptions {
   std::vector<std::string> mainline_edges;  ///< in driving order; empty = the discovery rule
   int clusters = 1;                         ///< RSU zones the mainline is split into
+  /// Where the zones start instead of equal parts (RoadSpec's keys of the same names): x
+  /// along the mainline [m], or the mainline edges they start at; at most one, `clusters` long.
+  std::vector<double> zone_starts_m;
+  std::vector<std::string> zone_start_edges;
 };
 
 /// The road found in a network: classified edges for RoadLayout and what the session needs.
@@ -80,14 +85,16 @@ struct OwnRoad {
   int num_main_lanes = 0;                  ///< L: most through lanes of a mainline edge
   int clusters = 1;
   double mainline_length_m = 0.0;
-  double cluster_length_m = 0.0;           ///< mainline_length_m / clusters
+  double cluster_length_m = 0.0;           ///< mainline_length_m / clusters (the mean zone length)
+  std::vector<double> zone_starts_m;       ///< x where each zone starts: clusters of them, the first 0
 };
 
 /// Finds the mainline, positions, ramps, acceleration lanes and zones (rule above).
 /// @throws std::invalid_argument naming what is wrong: an unknown or non-connected edge in
-///         mainline_edges, no mainline found (or an ambiguous one), clusters < 1, a zone
-///         with two on-ramps or two off-ramps, an off-ramp that does not leave from the
-///         rightmost lane.
+///         mainline_edges, no mainline found (or an ambiguous one), clusters < 1, zone
+///         starts that do not fit the mainline (not one per zone, not increasing, past its
+///         end, an edge not on it), a zone with two on-ramps or two off-ramps, an off-ramp
+///         that does not leave from the rightmost lane.
 OwnRoad discoverOwnRoad(const NetTopology& net, const OwnRoadOptions& options);
 
 }  // namespace palcas::sim

@@ -92,8 +92,9 @@ class RoadLayout {
   int mainLanesOn(const std::string& edge_id) const;
 
  private:
-  /// Zones of cluster_length_m_ over the mainline with the ramps and merge edges of `edges_`.
-  void buildClusters(int cluster_count);
+  /// Zones starting at `zone_starts_m` (each ends where the next starts, the last at the
+  /// mainline's end) with the ramps and merge edges of `edges_`.
+  void buildClusters(const std::vector<double>& zone_starts_m);
 
   std::vector<EdgeInfo> edges_;
   std::map<std::string, std::size_t> index_;

@@ -33,9 +33,15 @@ struct RoadSpec {
   double lane_width_m = 3.2;
   double speed_limit_mps = 33.528;     ///< mainline (paper 75 mph)
   double ramp_speed_limit_mps = 22.352;///< ramps (ours, 50 mph)
+  /// A road the user brings (network_file) only: where each RSU zone starts, as x along the
+  /// mainline [m] (the first 0, increasing) or as the mainline edges it starts at (the first
+  /// the mainline's first), one per zone, instead of `clusters` equal parts. At most one of
+  /// the two; its length must be `clusters`. A generated road's zones are its clusters.
+  std::vector<double> zone_starts_m;
+  std::vector<std::string> zone_start_edges;
 };
 
-/// Checks every field. Bounds: 1 <= clusters <= 100, 1 <= num_lanes <= 10, every number finite,
+/// Checks every field (zone_starts_m and zone_start_edges must be empty). Bounds: 1 <= clusters <= 100, 1 <= num_lanes <= 10, every number finite,
 /// 0 < cluster_length_m <= 100000, lane_width_m in (0, 10], speeds in (0, 100] m/s, and every
 /// edge at least 1 m long: 1 <= warmup_length_m, warmup_length_m + 1 <= merge_start_m,
 /// 1 <= acceleration_lane_m, merge_start_m + acceleration_lane_m + 1 <= exit_m,
