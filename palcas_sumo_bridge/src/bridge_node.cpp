@@ -47,7 +47,8 @@ BridgeNode::BridgeNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
             return std::make_unique<sim::SumoSession>(sessionOptionsFor(options_, sumocfg_path_, episode));
           })),
       markers_(std::make_unique<RvizMarkers>(session().laneShapes(), session().road(),
-                                             prepareRvizView(options_, session().laneShapes()))),
+                                             prepareRvizView(options_, session().laneShapes()),
+                                             session().rsuPoses())),
       rules_(measureRules(options_, session().road())),
       measure_(std::make_unique<EpisodeMeasure>(rules_)),
       auth_key_(common::loadMessageKey(options_.auth_key_file)) {

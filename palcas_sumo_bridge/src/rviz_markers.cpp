@@ -72,8 +72,8 @@ std_msgs::ColorRGBA advisoryColour(int action) {
 }
 
 RvizMarkers::RvizMarkers(std::vector<std::vector<std::pair<double, double>>> lane_shapes,
-                         const sim::RoadLayout& road, const RoadView& view)
-    : lane_shapes_(std::move(lane_shapes)), clusters_(road.clusters()), view_(view),
+                         const sim::RoadLayout& road, const RoadView& view, std::vector<sim::MapPose> rsu_poses)
+    : lane_shapes_(std::move(lane_shapes)), clusters_(road.clusters()), rsu_poses_(std::move(rsu_poses)), view_(view),
       extent_(roadExtent(lane_shapes_)) {}
 
 visualization_msgs::MarkerArray RvizMarkers::roadMarkers(const ros::Time& stamp) const {
@@ -170,7 +170,7 @@ visualization_msgs::MarkerArray RvizMarkers::dynamicMarkers(
 tf2_msgs::TFMessage RvizMarkers::transforms(const ros::Time& stamp,
                                             const std::vector<sim::VehicleRecord>& vehicles) const {
   tf2_msgs::TFMessage out;
-  out.transforms.reserve(vehicles.size() + clusters_.size());
+  out.transforms.reserve(vehicles.size() + rsu_poses_.size());
   auto make = [&](const std::string& child, double x, double y, double yaw) {
     geometry_msgs::TransformStamped t;
     t.header.stamp = stamp;
@@ -183,8 +183,8 @@ tf2_msgs::TFMessage RvizMarkers::transforms(const ros::Time& stamp,
     out.transforms.push_back(t);
   };
   for (const sim::VehicleRecord& v : vehicles) make("vehicle/" + v.id, v.map_x_m, v.map_y_m, v.heading_rad);
-  for (const sim::ClusterInfo& c : clusters_)
-    make("rsu_" + std::to_string(c.index), 0.5 * (c.x_start_m + c.x_end_m), -10.0, 0.0);
+  for (std::size_t k = 0; k < rsu_poses_.size(); ++k)
+    make("rsu_" + std::to_string(k), rsu_poses_[k].x_m, rsu_poses_[k].y_m, rsu_poses_[k].heading_rad);
   return out;
 }
 

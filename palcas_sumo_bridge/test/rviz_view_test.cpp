@@ -160,3 +160,19 @@ TEST(RvizMarkers, OneArrowPerAdvisoryColouredByAction) {
   EXPECT_EQ(none.markers[1].action, visualization_msgs::Marker::DELETE);
   EXPECT_EQ(none.markers[2].action, visualization_msgs::Marker::DELETE);
 }
+
+TEST(RvizMarkers, EachRsuFrameIsWhereItsPoseSays) {
+  using palcas::sim::EdgeInfo;
+  const palcas::sim::RoadLayout road({EdgeInfo{"main_0_up", {}, -1, 0.0, 600.0, 3, false}}, 3, 300.0);
+  const RoadView view = frameRoad(TINY, WindowPx{});
+  const palcas::bridge::RvizMarkers markers({{{0.0, -1.6}, {600.0, -1.6}}}, road, view,
+                                            {{150.0, -7.2, 0.0}, {420.0, 35.0, 1.5707963267948966}});
+  const auto tf = markers.transforms(ros::Time(3.0), {});
+  ASSERT_EQ(tf.transforms.size(), 2u);
+  EXPECT_EQ(tf.transforms[1].header.frame_id, "map");
+  EXPECT_EQ(tf.transforms[1].child_frame_id, "rsu_1");
+  EXPECT_DOUBLE_EQ(tf.transforms[1].transform.translation.x, 420.0);
+  EXPECT_DOUBLE_EQ(tf.transforms[1].transform.translation.y, 35.0);
+  EXPECT_NEAR(tf.transforms[1].transform.rotation.z, std::sqrt(0.5), 1e-12);  // a quarter turn
+  EXPECT_NEAR(tf.transforms[1].transform.rotation.w, std::sqrt(0.5), 1e-12);
+}

@@ -28,8 +28,9 @@ class RvizMarkers {
  public:
   /// @param lane_shapes polylines (x, y pairs) of every lane, for the road drawing
   /// @param view how the road is framed (scale, lateral stretch)
+  /// @param rsu_poses where each zone's RSU stands in the map (SumoSession::rsuPoses)
   RvizMarkers(std::vector<std::vector<std::pair<double, double>>> lane_shapes,
-              const sim::RoadLayout& road, const RoadView& view);
+              const sim::RoadLayout& road, const RoadView& view, std::vector<sim::MapPose> rsu_poses = {});
 
   /// Lanes and RSU zones (static: publish once, latched) and vehicles and advisories.
   visualization_msgs::MarkerArray roadMarkers(const ros::Time& stamp) const;
@@ -38,13 +39,14 @@ class RvizMarkers {
   visualization_msgs::MarkerArray dynamicMarkers(
       const ros::Time& stamp, const std::vector<sim::VehicleRecord>& vehicles,
       const std::vector<std::pair<std::string, int>>& advised) const;
-  /// map -> vehicle/<id> for every vehicle and map -> rsu_<k> for every zone centre.
+  /// map -> vehicle/<id> for every vehicle and map -> rsu_<k> for every RSU pose given.
   tf2_msgs::TFMessage transforms(const ros::Time& stamp,
                                  const std::vector<sim::VehicleRecord>& vehicles) const;
 
  private:
   std::vector<std::vector<std::pair<double, double>>> lane_shapes_;
   std::vector<sim::ClusterInfo> clusters_;
+  std::vector<sim::MapPose> rsu_poses_;
   RoadView view_;
   RoadExtent extent_;
 };

@@ -2,6 +2,8 @@
 # demand writer, and an in-process SUMO smoke run per scenario (libsumo holds one simulation
 # per process, hence one executable per scenario).
 palcas_sim_add_gtest(road_spec_test test/road_spec_test.cpp)
+# Where an RSU stands in the map (pure geometry).
+palcas_sim_add_gtest(roadside_test test/roadside_test.cpp)
 palcas_sim_add_gtest(scenario_network_test test/scenario_network_test.cpp)
 palcas_sim_add_gtest(scenario_demand_test test/scenario_demand_test.cpp)
 foreach(scenario tiny paper)

@@ -53,6 +53,27 @@ SumoSession::SumoSession(const SessionOptions& options) : options_(options), gua
       libsumo::VAR_LOADED_VEHICLES_NUMBER};
   api::Simulation::subscribe(sim_vars);
   readNetwork();
+  placeRsus();
+}
+
+void SumoSession::placeRsus() {
+  const std::vector<std::string>& main = road_->mainline();
+  for (const ClusterInfo& zone : road_->clusters()) {
+    const double centre_m = 0.5 * (zone.x_start_m + zone.x_end_m);
+    // The mainline edge at the centre (the last one past the road's end).
+    const EdgeInfo* at = &road_->edge(main.back());
+    for (const std::string& id : main) {
+      const EdgeInfo& e = road_->edge(id);
+      if (centre_m >= e.x_start_m && centre_m < e.x_end_m) {
+        at = &e;
+        break;
+      }
+    }
+    const std::string lane = at->id + "_" + std::to_string(std::max(road_->sumoLaneIndex(at->id, 1), 0));
+    std::vector<std::pair<double, double>> line;
+    for (const auto& p : api::Lane::getShape(lane).value) line.emplace_back(p.x, p.y);
+    rsu_poses_.push_back(poseAlong(line, centre_m - at->x_start_m, 0.5 * api::Lane::getWidth(lane) + RSU_SHOULDER_M));
+  }
 }
 
 SumoSession::~SumoSession() {

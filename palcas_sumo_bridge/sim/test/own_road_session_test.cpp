@@ -6,6 +6,10 @@
 #include "palcas_sim/sumo_session.h"
 
 #include <gtest/gtest.h>
+#include <libsumo/libsumo.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <map>
 #include <set>
@@ -42,6 +46,24 @@ TEST(OwnRoadSession, VehiclesDriveTheCurvedRoadMeasuredAlongIt) {
   ASSERT_EQ(road.numMainLanes(), 5);
   ASSERT_EQ(road.clusters().size(), 2u);
   const double length_m = road.mainlineLengthM();
+
+  // Each RSU stands at its zone's centre beside the rightmost through lane, on the curve as
+  // on the straight: about half a lane and the shoulder from that lane's centre line.
+  ASSERT_EQ(session.rsuPoses().size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& pose = session.rsuPoses()[k];
+    double nearest_m = 1e9;
+    for (const std::string& e : road.mainline()) {
+      const auto shape = libsumo::Lane::getShape(e + "_" + std::to_string(road.sumoLaneIndex(e, 1))).value;
+      for (std::size_t i = 1; i < shape.size(); ++i) {
+        const double ax = shape[i - 1].x, ay = shape[i - 1].y, dx = shape[i].x - ax, dy = shape[i].y - ay;
+        const double len2 = dx * dx + dy * dy;
+        const double t = len2 > 0.0 ? std::clamp(((pose.x_m - ax) * dx + (pose.y_m - ay) * dy) / len2, 0.0, 1.0) : 0.0;
+        nearest_m = std::min(nearest_m, std::hypot(pose.x_m - ax - t * dx, pose.y_m - ay - t * dy));
+      }
+    }
+    EXPECT_NEAR(nearest_m, 1.6 + palcas::sim::RSU_SHOULDER_M, 0.5) << "rsu_" << k;
+  }
 
   std::map<std::string, double> last_x;
   std::map<std::string, std::string> last_edge;

@@ -17,6 +17,7 @@
 #include "palcas_sim/advice_guard.h"
 #include "palcas_sim/own_road.h"
 #include "palcas_sim/road_layout.h"
+#include "palcas_sim/roadside.h"
 
 namespace palcas::sim {
 
@@ -187,6 +188,9 @@ class SumoSession {
   const std::vector<std::vector<std::pair<double, double>>>& laneShapes() const {
     return lane_shapes_;
   }
+  /// Where each zone's RSU stands in the map: beside the rightmost through lane at the zone's
+  /// centre, RSU_SHOULDER_M off it (roadside.h), on any road.
+  const std::vector<MapPose>& rsuPoses() const { return rsu_poses_; }
   const std::vector<VehicleRecord>& vehicles() const { return vehicles_; }
   /// nullptr when no such vehicle is on the road.
   const VehicleRecord* find(const std::string& id) const;
@@ -242,6 +246,8 @@ class SumoSession {
   /// readNetwork for a road of own_road_net_file: the layout from discoverOwnRoad, the edges
   /// the session needs from the layout's mainline order.
   void readOwnRoad();
+  /// rsu_poses_ from the road's zones and the lane shapes SUMO has.
+  void placeRsus();
   void onDeparted(const std::string& id);
   void readVehicles();
   void updateDerived(VehicleRecord& v) const;
@@ -280,6 +286,7 @@ class SumoSession {
   std::unordered_map<int, std::string> pre_exit_edge_;  ///< cluster -> mainline edge feeding its off-ramp
   std::unordered_set<std::string> index_shift_ahead_;   ///< edges whose successor numbers lanes differently
   std::vector<std::vector<std::pair<double, double>>> lane_shapes_;
+  std::vector<MapPose> rsu_poses_;
   double lane_width_m_ = 3.2;
   double step_length_s_ = 0.1;
   double time_s_ = 0.0;
