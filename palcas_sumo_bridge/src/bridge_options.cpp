@@ -107,6 +107,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.command_line = p.get<std::string>("command_line", "");
   o.git_commit = p.get<std::string>("git_commit", "");
   o.gui = p.get<bool>("gui", o.gui);
+  o.gui_quit_on_end = p.get<bool>("gui_quit_on_end", o.gui_quit_on_end);
   o.sumo_warnings = p.get<bool>("sumo_warnings", o.sumo_warnings);
   o.sumo_outputs = p.get<std::vector<std::string>>("sumo_outputs", o.sumo_outputs);
   o.sumo_fcd_period_s = p.number("sumo_fcd_period_s", o.sumo_fcd_period_s, 0.0, 3600.0);

@@ -242,7 +242,13 @@ sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string&
   if (o.sumo_warnings) s.sumo_args.insert(s.sumo_args.end(), {"--log", o.out_dir + "/sumo.log"});
   else s.sumo_args.insert(s.sumo_args.end(), {"--no-warnings", "true"});
   s.sumo_binary = o.gui ? "sumo-gui" : "sumo";
-  if (o.gui) s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", "true"});
+  if (o.gui) {
+    // Only the run's last episode may leave its window open: the others make way for the next.
+    const bool last = episode + 1 >= o.first_episode + o.episodes;
+    const bool stays_open = !o.gui_quit_on_end && last;
+    s.sumo_args.insert(s.sumo_args.end(), {"--start", "true", "--quit-on-end", stays_open ? "false" : "true"});
+    s.detach_sumo = stays_open;  // the bridge must not wait for a window its user closes
+  }
   if (!o.sumo_outputs.empty()) {
     const std::string dir = episodeDir(o, episode);
     fs::create_directories(dir);

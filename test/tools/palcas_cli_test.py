@@ -307,6 +307,32 @@ class ConsoleLog(unittest.TestCase):
         self.assertIn("[FATAL]", launch.last_fatal("[ INFO] ok\n[FATAL] [1.0]: bad key\n"))
 
 
+class MessageKey(unittest.TestCase):
+    """launch/scripts/message_key, which system.launch runs by default and ./palcas calls."""
+
+    def test_a_fresh_key_for_its_owner_only_kept_on_the_next_call(self):
+        folder = pathlib.Path(tempfile.mkdtemp(prefix="palcas_key_")) / "run" / "nested"
+        self.addCleanup(shutil.rmtree, folder.parents[1], True)
+        path = launch.message_key(str(folder))
+        self.assertEqual(path, str(folder / "auth.key"), "the path alone, no newline")
+        text = pathlib.Path(path).read_text()
+        self.assertRegex(text, r"^[0-9a-f]{64}$")
+        self.assertEqual(stat.S_IMODE(os.stat(path).st_mode), 0o600)
+        self.assertEqual(launch.message_key(str(folder)), path)
+        self.assertEqual(pathlib.Path(path).read_text(), text, "an existing key is kept")
+        other = pathlib.Path(tempfile.mkdtemp(prefix="palcas_key_"))
+        self.addCleanup(shutil.rmtree, other, True)
+        self.assertNotEqual(pathlib.Path(launch.message_key(str(other))).read_text(), text, "each run its own")
+
+    def test_a_folder_it_cannot_write_is_an_error_naming_it(self):
+        blocker = pathlib.Path(tempfile.mkdtemp(prefix="palcas_key_")) / "a_file"
+        self.addCleanup(shutil.rmtree, blocker.parent, True)
+        blocker.write_text("not a folder")
+        with self.assertRaises(OSError) as caught:
+            launch.message_key(str(blocker / "run"))
+        self.assertIn("a_file", str(caught.exception))
+
+
 class LaunchRunner(unittest.TestCase):
     """The runner against a stand-in roslaunch (no ROS needed)."""
 

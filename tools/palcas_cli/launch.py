@@ -44,16 +44,14 @@ def ros_env(port, log_dir=None):
 
 def message_key(folder):
     """<folder>/auth.key: the run's or training's random message key (palcas_common/README.md),
-    hex, readable by its owner only, made on first use. Every node of the run reads it: RSUs
-    sign advisories and submissions, the bridge and the server refuse the rest."""
-    key = os.path.join(folder, "auth.key")
-    if not (os.path.isfile(key) and os.path.getsize(key) > 0):
-        tmp = key + ".tmp"
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        with os.fdopen(fd, "w") as f:
-            f.write(os.urandom(32).hex())
-        os.replace(tmp, key)
-    return key
+    made on first use by the launch package's scripts/message_key (the one that system.launch
+    runs by default). Every node of the run reads it: RSUs sign advisories and submissions, the
+    bridge and the server refuse the rest."""
+    script = os.path.join(ROOT, "launch", "scripts", "message_key")
+    done = subprocess.run([script, folder], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        raise OSError(done.stderr.strip() or "%s failed" % script)
+    return done.stdout
 
 
 def git_commit():

@@ -44,7 +44,8 @@ HELPS = {
     "--scenario": ("NAME", D("road under config/scenarios, or an absolute path to a folder with scenario.yaml",
                              "the policy's road, else paper")),
     "--out": ("DIR", D("run folder", "results/run-<time>-pr<P>-d<demand>-s<N>")),
-    "--gui": (None, D("attach an external sumo-gui through libtraci", "off")),
+    "--gui": (None, D("attach an external sumo-gui through libtraci; the last arm's window stays open on its "
+                      "final state until you close it", "off")),
     "--rviz": (None, D("watch each arm in rviz, framed on its road; the last arm's window stays open until "
                        "you close it", "off")),
     "--real-time-factor": ("X", D("simulate at most X times faster than wall time (X > 0)",
@@ -209,6 +210,8 @@ def run_arms(p, console, show, rviz):
         os.makedirs(folder, exist_ok=True)
         remove(metrics)  # a stale file must not stand for a failed run
         args = ["palcas_launch", "system.launch", "arm:=" + arm] + common
+        if p.gui:  # one window left open: the last arm's
+            args.append("gui_quit_on_end:=" + flag(arm != p.arms[-1]))
         if palcas_arms.is_learning(arm):
             console.log("%s: evaluating the policy %s -> %s" % (arm, p.policy, folder))
             # A policy folder's bridge.yaml (tools/ship_policy.py) is how that policy is run.

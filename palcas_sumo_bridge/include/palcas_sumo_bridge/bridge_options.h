@@ -51,6 +51,10 @@ struct BridgeOptions {
   std::string git_commit;          ///< for the manifest
   // SUMO.
   bool gui = false;                ///< true: external sumo-gui over libtraci
+  /// With gui: sumo-gui quits when the run ends (true) or stays open on the last episode's
+  /// final state until its user closes it (false, the default: a window that vanishes as the
+  /// run ends shows nothing). Earlier episodes' windows always quit.
+  bool gui_quit_on_end = false;
   bool sumo_warnings = false;      ///< true: SUMO's warnings on the console and in <out_dir>/sumo.log
   /// SUMO's own output files by name (palcas_sim/sumo_outputs.h: fcd, tripinfo, ssm,
   /// lanechange, collision, summary, statistic), written into the run folder (episode_<k>/

@@ -11,6 +11,13 @@
 #include <limits>
 #include <stdexcept>
 
+#ifdef PALCAS_USE_LIBTRACI
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+#endif
+
 #include "palcas_sim/sumo_session.h"
 
 #include "sumo_session_api.h"
@@ -18,6 +25,47 @@
 namespace palcas::sim {
 
 using namespace session_detail;
+
+#ifdef PALCAS_USE_LIBTRACI
+namespace {
+
+/// A TCP port free on this host now (the kernel's pick for port 0).
+int freeTcpPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) throw std::runtime_error("no socket to find a free TraCI port");
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  const bool ok = ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
+                  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0;
+  ::close(fd);
+  if (!ok) throw std::runtime_error("cannot find a free TraCI port");
+  return ntohs(a.sin_port);
+}
+
+/// Starts `cmd` in a session of its own, output to /dev/null, not waited for.
+void spawnDetached(const std::vector<std::string>& cmd) {
+  std::vector<char*> argv;
+  for (const std::string& a : cmd) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("cannot start " + cmd[0] + ": fork failed");
+  if (pid == 0) {
+    ::setsid();
+    const int null = ::open("/dev/null", O_RDWR);
+    if (null >= 0) {
+      ::dup2(null, 0);
+      ::dup2(null, 1);
+      ::dup2(null, 2);
+    }
+    ::execvp(argv[0], argv.data());
+    ::_exit(127);
+  }
+}
+
+}  // namespace
+#endif
 
 const char* SumoSession::apiName() {
 #ifdef PALCAS_USE_LIBTRACI
@@ -37,7 +85,14 @@ SumoSession::SumoSession(const SessionOptions& options) : options_(options), gua
   if (options_.remove_collided) cmd.insert(cmd.end(), {"--collision.action", "warn"});
   try {
 #ifdef PALCAS_USE_LIBTRACI
-    api::Simulation::start(cmd, options_.traci_port);
+    if (options_.detach_sumo) {
+      const int port = options_.traci_port > 0 ? options_.traci_port : freeTcpPort();
+      cmd.insert(cmd.end(), {"--remote-port", std::to_string(port)});
+      spawnDetached(cmd);
+      api::Simulation::init(port, 600);  // up to a minute for a GUI to come up
+    } else {
+      api::Simulation::start(cmd, options_.traci_port);
+    }
 #else
     api::Simulation::load(std::vector<std::string>(cmd.begin() + 1, cmd.end()));
 #endif

@@ -28,6 +28,10 @@ struct SessionOptions {
   std::vector<std::string> sumo_args;  ///< arguments after the binary, e.g. {"-c", "x.sumocfg"}
   std::string sumo_binary = "sumo";    ///< libtraci only: "sumo" or "sumo-gui"
   int traci_port = -1;                 ///< libtraci only: -1 = let SUMO choose
+  /// libtraci only: SUMO runs as a process of its own session that nobody waits for, and the
+  /// session connects to it by port (libtraci's start() waits for the process it started as
+  /// it closes, so a sumo-gui that stays open at the end would hold the bridge forever).
+  bool detach_sumo = false;
   double cluster_length_m = 800.0;
   /// A user's own road (scenario network_file): the .net.xml SUMO runs, in which the road is
   /// found by discoverOwnRoad with own_road (cluster_length_m is then the mainline length /
