@@ -1,29 +1,36 @@
-// palcas_bench: timings of the learning core (not a pass/fail test). Prints a table and
-// writes JSON (--out FILE, default results/bench.json). Every figure is measured in BOTH
-// thread CPU time (leaves out the time other processes hold the core: the machine is
-// shared) and wall-clock time, over --reps repetitions (default 5), reporting the median of
-// the per-repetition figures:
+// palcas_bench: timings of the learning core (not a pass/fail test) on Google Benchmark.
+// Prints Google Benchmark's table and ours, and writes JSON (--out FILE, default
+// results/bench.json). Every figure is measured in BOTH thread CPU time (leaves out the time
+// other processes hold the core: the machine is shared) and wall-clock time, over --reps
+// repetitions (default 5), reporting the median of the per-repetition figures:
 //   grad_step_ms_1thread: one full P-DQN update (both networks, batch 256, the paper
 //     network, replay prefilled), mean over 20 updates per repetition;
 //   grad_step_ms_2threads: the same with Eigen on 2 threads, wall-clock time;
 //   infer_ms_p50 / infer_ms_p99 {"1","10","50","100","200"}: one batched greedy act() in
 //     eval mode for that many CAVs, one thread, percentiles over the calls of a repetition;
 //   act_after_update_ms {"100"}: act() for 100 CAVs right after an update (includes
-//     re-folding both networks' batch norms, see FoldedNetwork);
+//     re-folding both networks' batch norms, see FoldedNetwork), p50 over 10 x reps calls;
 //   fedavg_ms {"3","30","300"}: fedAverage of that many paper-size models;
 //   load_average_start/end: /proc/loadavg 1-minute load when the run started / ended.
+// Google Benchmark runs the repetitions, times the fixed iteration counts and takes the
+// medians; percentiles over single calls are no figure of its own, so those benchmarks time
+// each call on both clocks and hand the percentiles to it as counters.
+#include <benchmark/benchmark.h>
+
 #include <Eigen/Core>
 
 #include <algorithm>
-#include <cstdlib>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include "palcas_core/learning/fedavg.h"
 #include "palcas_core/learning/pdqn_agent.h"
@@ -37,9 +44,8 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
+constexpr int CAV_COUNTS[] = {1, 10, 50, 100, 200};
+constexpr int MODEL_COUNTS[] = {3, 30, 300};
 
 // CPU time of the calling thread, ms.
 double threadCpuMs() {
@@ -74,48 +80,27 @@ struct Timing {
   double cpu_ms = 0, wall_ms = 0;
 };
 
-// Runs `body` once and times it on both clocks.
-template <typename Body>
-Timing timed(Body&& body) {
-  const double cpu_start = threadCpuMs();
-  const auto start = Clock::now();
-  body();
-  return {threadCpuMs() - cpu_start, msSince(start)};
-}
-
-// Median over repetitions of per-repetition figures, each clock separately.
-Timing median(const std::vector<Timing>& reps) {
-  std::vector<double> cpu, wall;
-  for (const Timing& t : reps) {
-    cpu.push_back(t.cpu_ms);
-    wall.push_back(t.wall_ms);
+// Per-call timings on both clocks, for the percentile figures.
+class CallTimes {
+ public:
+  template <typename Body>
+  void time(Body&& body) {
+    const double cpu_start = threadCpuMs();
+    const auto start = Clock::now();
+    body();
+    cpu_.push_back(threadCpuMs() - cpu_start);
+    wall_.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
   }
-  return {percentile(cpu, 0.5), percentile(wall, 0.5)};
-}
-
-// Percentile q of per-call timings, each clock separately.
-Timing percentileOf(const std::vector<Timing>& calls, double q) {
-  std::vector<double> cpu, wall;
-  for (const Timing& t : calls) {
-    cpu.push_back(t.cpu_ms);
-    wall.push_back(t.wall_ms);
+  /// Percentile q of the calls as counters <prefix>_cpu_ms / <prefix>_wall_ms of `state`;
+  /// Google Benchmark's median aggregate then takes their median over repetitions.
+  void report(benchmark::State& state, const std::string& prefix, double q) const {
+    state.counters[prefix + "_cpu_ms"] = percentile(cpu_, q);
+    state.counters[prefix + "_wall_ms"] = percentile(wall_, q);
   }
-  return {percentile(cpu, q), percentile(wall, q)};
-}
 
-Timing gradStepMs(PdqnAgent& agent, int threads, int reps) {
-  Eigen::setNbThreads(threads);
-  for (int i = 0; i < 3; ++i) agent.update();  // warm-up: sizes the scratch matrices
-  constexpr int UPDATES = 20;
-  std::vector<Timing> per_rep;
-  for (int r = 0; r < reps; ++r) {
-    Timing t = timed([&] {
-      for (int i = 0; i < UPDATES; ++i) agent.update();
-    });
-    per_rep.push_back({t.cpu_ms / UPDATES, t.wall_ms / UPDATES});
-  }
-  return median(per_rep);
-}
+ private:
+  std::vector<double> cpu_, wall_;
+};
 
 double loadAverage() {
   std::ifstream in("/proc/loadavg");
@@ -142,66 +127,95 @@ const char* blasBackend() {
 #endif
 }
 
-struct InferResult {
-  std::map<int, double> p50, p99, wall_p50, wall_p99;
+// The benchmarks, in the order they run (registration order); all share one agent, as the
+// figures always did (the decision timings run on an agent that has been updated).
+void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
+  for (int threads : {1, 2}) {
+    benchmark::RegisterBenchmark(
+        ("grad_step/threads:" + std::to_string(threads)).c_str(),
+        [&agent, threads](benchmark::State& state) {
+          Eigen::setNbThreads(threads);
+          for (int i = 0; i < 3; ++i) agent.update();  // warm-up: sizes the scratch matrices
+          for (auto _ : state) agent.update();
+          Eigen::setNbThreads(1);
+        })
+        ->Iterations(20);  // a repetition's figure: the mean over 20 updates
+  }
+  for (int cavs : CAV_COUNTS) {
+    benchmark::RegisterBenchmark(
+        ("act/cavs:" + std::to_string(cavs)).c_str(),
+        [&agent, cavs](benchmark::State& state) {
+          Rng rng(static_cast<uint64_t>(6 + cavs));
+          const nn::Matrix states = randomStates(agent.config().state_size, cavs, rng);
+          std::vector<Decision> decisions;
+          for (int i = 0; i < 20; ++i) agent.act(states, false, decisions);  // warm-up
+          CallTimes calls;
+          for (auto _ : state) calls.time([&] { agent.act(states, false, decisions); });
+          calls.report(state, "p50", 0.50);
+          calls.report(state, "p99", 0.99);
+        })
+        ->Iterations(cavs <= 50 ? 1000 : 400);
+  }
+  // act() for 100 CAVs right after update(): the decision then re-folds both networks. One
+  // repetition of 10 x reps calls: its p50 is the figure.
+  benchmark::RegisterBenchmark("act_after_update/cavs:100", [&agent](benchmark::State& state) {
+    Rng rng(7);
+    const nn::Matrix states = randomStates(agent.config().state_size, 100, rng);
+    std::vector<Decision> decisions;
+    CallTimes calls;
+    for (auto _ : state) {
+      state.PauseTiming();
+      agent.update();
+      state.ResumeTiming();
+      calls.time([&] { agent.act(states, false, decisions); });
+    }
+    calls.report(state, "p50", 0.50);
+  })->Iterations(10 * reps)->Repetitions(1);
+  for (int count : MODEL_COUNTS) {
+    benchmark::RegisterBenchmark(
+        ("fedavg/models:" + std::to_string(count)).c_str(),
+        [&agent, &base, count](benchmark::State& state) {
+          // The agent's model after every update above (not timed: before the loop).
+          if (base.values.empty()) base = agent.exportModel();
+          std::vector<ModelBlob> models(static_cast<size_t>(count), base);
+          for (size_t k = 0; k < models.size(); ++k) models[k].values[k] += 1e-3f;  // distinct
+          const std::vector<uint64_t> n(models.size(), 2500);
+          size_t size = 0;
+          for (auto _ : state) size = fedAverage(models, n).values.size();
+          if (size != base.values.size()) state.SkipWithError("fedAverage changed the size");
+        })
+        ->Iterations(1);
+  }
+}
+
+// Keeps each benchmark's median over repetitions (or its single run) by name, and shows
+// Google Benchmark's own table as it goes.
+class Collector : public benchmark::ConsoleReporter {
+ public:
+  explicit Collector(OutputOptions options) : ConsoleReporter(options) {}
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.error_occurred) failed_ = true;
+      const bool single = run.repetitions <= 1 && run.run_type == Run::RT_Iteration;
+      if (single || (run.run_type == Run::RT_Aggregate && run.aggregate_name == "median"))
+        medians_[run.run_name.function_name] = run;
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  bool failed() const { return failed_; }
+  Timing time(const std::string& name) const {
+    const Run& run = medians_.at(name);
+    return {run.GetAdjustedCPUTime(), run.GetAdjustedRealTime()};
+  }
+  Timing counters(const std::string& name, const std::string& prefix) const {
+    const Run& run = medians_.at(name);
+    return {run.counters.at(prefix + "_cpu_ms"), run.counters.at(prefix + "_wall_ms")};
+  }
+
+ private:
+  std::map<std::string, Run> medians_;
+  bool failed_ = false;
 };
-
-// act() timings per batch size: per repetition the p50/p99 over its calls, then medians.
-InferResult inferTimings(PdqnAgent& agent, int reps) {
-  InferResult result;
-  Rng rng(6);
-  std::vector<Decision> decisions;
-  for (int cavs : {1, 10, 50, 100, 200}) {
-    const nn::Matrix states = randomStates(agent.config().state_size, cavs, rng);
-    for (int i = 0; i < 20; ++i) agent.act(states, false, decisions);
-    const int calls = cavs <= 50 ? 1000 : 400;
-    std::vector<Timing> p50s, p99s;
-    for (int r = 0; r < reps; ++r) {
-      std::vector<Timing> samples;
-      for (int i = 0; i < calls; ++i)
-        samples.push_back(timed([&] { agent.act(states, false, decisions); }));
-      p50s.push_back(percentileOf(samples, 0.50));
-      p99s.push_back(percentileOf(samples, 0.99));
-    }
-    const Timing p50 = median(p50s), p99 = median(p99s);
-    result.p50[cavs] = p50.cpu_ms;
-    result.p99[cavs] = p99.cpu_ms;
-    result.wall_p50[cavs] = p50.wall_ms;
-    result.wall_p99[cavs] = p99.wall_ms;
-  }
-  return result;
-}
-
-// act() for 100 CAVs right after update(): the decision then re-folds both networks.
-Timing actAfterUpdate(PdqnAgent& agent, int reps) {
-  Rng rng(7);
-  const nn::Matrix states = randomStates(agent.config().state_size, 100, rng);
-  std::vector<Decision> decisions;
-  std::vector<Timing> samples;
-  for (int i = 0; i < 10 * reps; ++i) {
-    agent.update();
-    samples.push_back(timed([&] { agent.act(states, false, decisions); }));
-  }
-  return percentileOf(samples, 0.5);
-}
-
-std::map<int, Timing> fedAvgTimings(const ModelBlob& base, int reps) {
-  std::map<int, Timing> result;
-  std::vector<ModelBlob> all(300, base);
-  for (size_t k = 0; k < all.size(); ++k) all[k].values[k] += 1e-3f;  // distinct models
-  for (int count : {3, 30, 300}) {
-    const std::vector<ModelBlob> models(all.begin(), all.begin() + count);
-    const std::vector<uint64_t> n(static_cast<size_t>(count), 2500);
-    std::vector<Timing> samples;
-    for (int rep = 0; rep < reps; ++rep) {
-      size_t size = 0;
-      samples.push_back(timed([&] { size = fedAverage(models, n).values.size(); }));
-      if (size != base.values.size()) std::abort();
-    }
-    result[count] = median(samples);
-  }
-  return result;
-}
 
 void printRow(const std::string& name, double cpu, double wall) {
   if (cpu < 0)
@@ -224,50 +238,77 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: palcas_bench [--out FILE] [--reps N]\n"
-                   "  Times the learning core (paper network, float) and writes JSON to FILE\n"
-                   "  (default results/bench.json). Figures are medians over N repetitions\n"
-                   "  (default 5) in thread CPU time and wall-clock time. Run it when the\n"
-                   "  machine is quiet: the JSON records the load average.\n");
+                   "  Times the learning core (paper network, float) on Google Benchmark and\n"
+                   "  writes JSON to FILE (default results/bench.json). Figures are medians over\n"
+                   "  N repetitions (default 5) in thread CPU time and wall-clock time. Run it\n"
+                   "  when the machine is quiet: the JSON records the load average.\n");
       return arg == "--help" || arg == "-h" ? 0 : 2;
     }
   }
+  // Every benchmark runs --reps times and reports only its aggregates (the median is ours);
+  // milliseconds as the figures are.
+  const std::string repetitions = "--benchmark_repetitions=" + std::to_string(reps);
+  char* gb_argv[] = {argv[0], const_cast<char*>(repetitions.c_str()),
+                     const_cast<char*>("--benchmark_report_aggregates_only=true"),
+                     const_cast<char*>("--benchmark_time_unit=ms"), nullptr};
+  int gb_argc = 4;
+  benchmark::Initialize(&gb_argc, gb_argv);
+
   const double load_start = loadAverage();
   PdqnConfig config;  // the paper's network and hyper-parameters
   PdqnAgent agent(config);
   prefill(agent, 10000);
-
-  const Timing grad_1 = gradStepMs(agent, 1, reps);
-  const Timing grad_2 = gradStepMs(agent, 2, reps);
   Eigen::setNbThreads(1);
-  const InferResult infer = inferTimings(agent, reps);
-  const Timing after_update = actAfterUpdate(agent, reps);
-  const ModelBlob base = agent.exportModel();
-  const std::map<int, Timing> fedavg = fedAvgTimings(base, reps);
+  ModelBlob base_model;  // exported by the first FedAvg benchmark
+  registerBenchmarks(agent, base_model, reps);
+  // Colours only on a terminal: a log of ./palcas bench gets no escape codes.
+  Collector collector(isatty(fileno(stdout)) ? benchmark::ConsoleReporter::OO_ColorTabular
+                                             : benchmark::ConsoleReporter::OO_Tabular);
+  benchmark::RunSpecifiedBenchmarks(&collector);
+  benchmark::Shutdown();
   const double load_end = loadAverage();
+  if (collector.failed()) {
+    std::fprintf(stderr, "palcas_bench: a benchmark failed (above)\n");
+    return 1;
+  }
+
+  const Timing grad_1 = collector.time("grad_step/threads:1");
+  const Timing grad_2 = collector.time("grad_step/threads:2");
+  std::map<int, double> p50, p99, wall_p50, wall_p99, fed_cpu, fed_wall;
+  for (int cavs : CAV_COUNTS) {
+    const std::string name = "act/cavs:" + std::to_string(cavs);
+    const Timing median_p50 = collector.counters(name, "p50");
+    const Timing median_p99 = collector.counters(name, "p99");
+    p50[cavs] = median_p50.cpu_ms;
+    wall_p50[cavs] = median_p50.wall_ms;
+    p99[cavs] = median_p99.cpu_ms;
+    wall_p99[cavs] = median_p99.wall_ms;
+  }
+  const Timing after_update = collector.counters("act_after_update/cavs:100", "p50");
+  for (int count : MODEL_COUNTS) {
+    const Timing t = collector.time("fedavg/models:" + std::to_string(count));
+    fed_cpu[count] = t.cpu_ms;
+    fed_wall[count] = t.wall_ms;
+  }
 
   std::printf("PALCAS learning-core bench (flags: %s; Eigen SIMD: %s)\n", PALCAS_BENCH_FLAGS,
               Eigen::SimdInstructionSetsInUse());
   std::printf("BLAS backend: %s\n", blasBackend());
   std::printf("model: %zu floats (mu + Q, params + BN stats); %d repetitions, medians;"
               " load average %.2f -> %.2f\n",
-              base.values.size(), reps, load_start, load_end);
+              base_model.values.size(), reps, load_start, load_end);
   std::printf("%-52s %10s %10s\n", "measure", "cpu ms", "wall ms");
   printRow("P-DQN gradient step, batch 256, 1 thread", grad_1.cpu_ms, grad_1.wall_ms);
   printRow("P-DQN gradient step, batch 256, 2 threads", -1, grad_2.wall_ms);
-  for (const auto& [cavs, p50] : infer.p50) {
+  for (int cavs : CAV_COUNTS) {
     const std::string name = "act() " + std::to_string(cavs) + " CAVs, eval, 1 thread";
-    printRow(name + ", p50", p50, infer.wall_p50.at(cavs));
-    printRow(name + ", p99", infer.p99.at(cavs), infer.wall_p99.at(cavs));
+    printRow(name + ", p50", p50[cavs], wall_p50[cavs]);
+    printRow(name + ", p99", p99[cavs], wall_p99[cavs]);
   }
   printRow("act() 100 CAVs right after update(), p50", after_update.cpu_ms, after_update.wall_ms);
-  for (const auto& [count, t] : fedavg)
-    printRow("FedAvg of " + std::to_string(count) + " models", t.cpu_ms, t.wall_ms);
+  for (int count : MODEL_COUNTS)
+    printRow("FedAvg of " + std::to_string(count) + " models", fed_cpu[count], fed_wall[count]);
 
-  std::map<int, double> fed_cpu, fed_wall;
-  for (const auto& [count, t] : fedavg) {
-    fed_cpu[count] = t.cpu_ms;
-    fed_wall[count] = t.wall_ms;
-  }
   const std::filesystem::path path(out_path);
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::ofstream out(out_path);
@@ -278,17 +319,17 @@ int main(int argc, char** argv) {
       << "  \"repetitions\": " << reps << ",\n"
       << "  \"load_average_start\": " << load_start << ",\n"
       << "  \"load_average_end\": " << load_end << ",\n"
-      << "  \"model_values\": " << base.values.size() << ",\n"
+      << "  \"model_values\": " << base_model.values.size() << ",\n"
       << "  \"batch_size\": " << config.batch_size << ",\n"
       << "  \"timing\": \"medians over repetitions; plain names are thread CPU time, *_wall_* "
          "wall-clock\",\n"
       << "  \"grad_step_ms_1thread\": " << grad_1.cpu_ms << ",\n"
       << "  \"grad_step_wall_ms_1thread\": " << grad_1.wall_ms << ",\n"
       << "  \"grad_step_ms_2threads\": " << grad_2.wall_ms << ",\n"
-      << "  \"infer_ms_p50\": " << jsonObject(infer.p50) << ",\n"
-      << "  \"infer_ms_p99\": " << jsonObject(infer.p99) << ",\n"
-      << "  \"infer_wall_ms_p50\": " << jsonObject(infer.wall_p50) << ",\n"
-      << "  \"infer_wall_ms_p99\": " << jsonObject(infer.wall_p99) << ",\n"
+      << "  \"infer_ms_p50\": " << jsonObject(p50) << ",\n"
+      << "  \"infer_ms_p99\": " << jsonObject(p99) << ",\n"
+      << "  \"infer_wall_ms_p50\": " << jsonObject(wall_p50) << ",\n"
+      << "  \"infer_wall_ms_p99\": " << jsonObject(wall_p99) << ",\n"
       << "  \"act_after_update_ms\": {\"100\": " << after_update.cpu_ms << "},\n"
       << "  \"act_after_update_wall_ms\": {\"100\": " << after_update.wall_ms << "},\n"
       << "  \"fedavg_ms\": " << jsonObject(fed_cpu) << ",\n"

@@ -2,8 +2,7 @@
 # PDQN agent, FedAvg
 list(APPEND PALCAS_CORE_SOURCES
   lib/learning/nn/linear.cpp
-  lib/learning/nn/relu.cpp
-  lib/learning/nn/tanh.cpp
+  lib/learning/nn/activation.cpp
   lib/learning/nn/batch_norm.cpp
   lib/learning/nn/dropout.cpp
   lib/learning/nn/network.cpp

@@ -1,6 +1,8 @@
-# learning targets: palcas_bench (timed harness, writes JSON; run by ./palcas bench)
+# learning targets: palcas_bench (Google Benchmark runs the timings, it writes JSON; run by
+# ./palcas bench)
+find_package(benchmark REQUIRED)
 add_executable(palcas_bench bench/palcas_bench.cpp)
-target_link_libraries(palcas_bench palcas_core)
+target_link_libraries(palcas_bench palcas_core benchmark::benchmark)
 target_compile_options(palcas_bench PRIVATE ${PALCAS_CORE_COMPILE_OPTIONS})
 # The flags the numbers were measured with go into the JSON.
 string(REPLACE ";" " " PALCAS_BENCH_FLAGS "${CMAKE_CXX_FLAGS_RELEASE} ${PALCAS_CORE_COMPILE_OPTIONS} -fopenmp")

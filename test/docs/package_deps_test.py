@@ -9,6 +9,7 @@
   the package holding that launch file; test launch files' packages are test dependencies;
 - every third-party module a package's Python imports is one of its dependencies (tools/,
   not a catkin package, counts as palcas_launch's: its commands start those launches);
+- catkin_lint reports no error or warning on any package;
 - every rosdep key a package.xml names resolves: a package of this repository, or a key of
   rosdep/keys.yaml (Debian's rules, rosdistro's, rosdep/palcas.yaml's), checked against
   Debian's rules file where python3-rosdep2 is installed; the repository's LICENSE is the
@@ -231,6 +232,22 @@ class PackageDepsTest(unittest.TestCase):
         resolved = {p for section in listed.values() for packages in section.values() for p in packages}
         self.assertEqual(sorted(p for p in installed if p not in resolved and p not in tools), [],
                          "./palcas installs Debian packages no rosdep key of a package.xml resolves to")
+
+    def test_catkin_lint_finds_no_error_or_warning(self):
+        # catkin_lint (Debian's catkin-lint) checks each package's CMakeLists.txt against its
+        # package.xml the way catkin uses them. --strict fails on its errors and warnings alike;
+        # a false positive is suppressed in the CMakeLists.txt by a "#catkin_lint: ignore_once"
+        # pragma with the reason beside it. Its notices (-W2) are tolerated: style only
+        # (${PROJECT_NAME} over the name, sorted lists, and launch/, policies/ and test/ holding
+        # packages named otherwise, which the repository's layout wants). --offline: no rosdep
+        # download (the rosdep keys are checked above, against rosdep/keys.yaml).
+        if not pathlib.Path("/usr/bin/catkin_lint").exists():
+            self.fail("catkin_lint is not installed: ./palcas setup installs catkin-lint")
+        folders = [str(ROOT / f) for f in package_folders()]
+        r = subprocess.run(["/usr/bin/catkin_lint", "--offline", "--strict", "-W1", "--color", "never"] + folders,
+                           capture_output=True, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, "catkin_lint:\n" + r.stdout + r.stderr)
+        self.assertIn("checked %d packages and found 0 problems" % len(folders), r.stderr + r.stdout)
 
     def test_the_license_every_package_names_is_the_repositorys(self):
         text = (ROOT / "LICENSE").read_text()

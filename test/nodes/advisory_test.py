@@ -5,8 +5,9 @@ The node registers with the bridge as ~rsu_id and answers every step (lockstep).
 sets a plan (a function of the state) that decides the advisories of the next steps.
 """
 import math
+import os
+import sys
 import threading
-import time
 import unittest
 
 import rospy
@@ -14,10 +15,16 @@ import rostest
 from palcas_msgs.msg import Advisory, AdvisoryArray, AdvisoryRejection, EpisodeMetrics, VehicleStateArray
 from palcas_msgs.srv import RegisterRsu
 
+# waiting.py beside this file (catkin's devel relay runs this file from elsewhere).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from waiting import WaitUntil  # noqa: E402
+
 WALL_TIMEOUT_S = 60.0
 
 
-class AdvisoryTest(unittest.TestCase):
+class AdvisoryTest(WaitUntil, unittest.TestCase):
+    WALL_TIMEOUT_S = WALL_TIMEOUT_S
+
     @classmethod
     def setUpClass(cls):
         cls.rsu_id = rospy.get_param("~rsu_id", "test_rsu")
@@ -68,16 +75,6 @@ class AdvisoryTest(unittest.TestCase):
     @staticmethod
     def advisory(vehicle_id, action, accel=0.0):
         return Advisory(vehicle_id=vehicle_id, action=action, accel_mps2=accel, model_version=0)
-
-    def wait_until(self, condition, what):
-        end = time.monotonic() + WALL_TIMEOUT_S
-        while time.monotonic() < end and not rospy.is_shutdown():
-            with self.lock:
-                result = condition()
-            if result:
-                return result
-            time.sleep(0.01)
-        self.fail("timed out waiting for " + what)
 
     def latest(self):
         return self.history[-1] if self.history else None

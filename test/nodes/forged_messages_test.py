@@ -15,8 +15,8 @@ import hashlib
 import hmac
 import io
 import os
+import sys
 import threading
-import time
 import unittest
 
 import rospy
@@ -24,6 +24,10 @@ import rostest
 from palcas_msgs.msg import (Advisory, AdvisoryArray, AdvisoryRejection, EpisodeMetrics, FederationStatus,
                              VehicleStateArray)
 from palcas_msgs.srv import FetchGlobalModel, RegisterRsu, SubmitWeights
+
+# waiting.py beside this file (catkin's devel relay runs this file from elsewhere).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from waiting import WaitUntil, poll  # noqa: E402
 
 WALL_TIMEOUT_S = 60.0
 RSU = "rsu_0"
@@ -55,7 +59,9 @@ def signed(msg, key):
     return msg
 
 
-class ForgedMessagesTest(unittest.TestCase):
+class ForgedMessagesTest(WaitUntil, unittest.TestCase):
+    WALL_TIMEOUT_S = WALL_TIMEOUT_S
+
     @classmethod
     def setUpClass(cls):
         cls.key = read_key(rospy.get_param("~auth_key_file"))
@@ -75,9 +81,7 @@ class ForgedMessagesTest(unittest.TestCase):
         rospy.wait_for_service("/register_rsu", timeout=WALL_TIMEOUT_S)
         # The bridge must hear this node from step 0 on: registering before the link to its
         # subscriber is up would leave step 0 unanswered.
-        end = time.monotonic() + WALL_TIMEOUT_S
-        while cls.pub.get_num_connections() < 1 and time.monotonic() < end:
-            time.sleep(0.01)
+        poll(lambda: cls.pub.get_num_connections() >= 1, WALL_TIMEOUT_S, interval_s=0.01)
         reply = rospy.ServiceProxy("/register_rsu", RegisterRsu)(rsu_id=RSU)
         assert reply.accepted, reply.reason
 
@@ -119,16 +123,6 @@ class ForgedMessagesTest(unittest.TestCase):
         with cls.lock:
             cls.fed_status = {"accepted_total": msg.accepted_total,
                               "rejected_by_reason": dict(zip(msg.rejection_reasons, msg.rejections))}
-
-    def wait_until(self, condition, what):
-        end = time.monotonic() + WALL_TIMEOUT_S
-        while time.monotonic() < end and not rospy.is_shutdown():
-            with self.lock:
-                result = condition()
-            if result:
-                return result
-            time.sleep(0.01)
-        self.fail("timed out waiting for " + what)
 
     def test_forged_arrays_are_refused_counted_and_never_displace_the_genuine_one(self):
         # Enough steps with CAVs on the road that forged braking would show.

@@ -7,7 +7,9 @@ bridge must move on after ~deadline_s per step and count late steps. Then it ans
 at once: the pace recovers. Wide margins: the checks are about the order of magnitude, not
 timing luck.
 """
+import os
 import statistics
+import sys
 import threading
 import time
 import unittest
@@ -17,8 +19,12 @@ import rostest
 from palcas_msgs.msg import AdvisoryArray, EpisodeMetrics, VehicleStateArray
 from palcas_msgs.srv import RegisterRsu
 
+# waiting.py beside this file (catkin's devel relay runs this file from elsewhere).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from waiting import WaitUntil, poll  # noqa: E402
 
-class LockstepTest(unittest.TestCase):
+
+class LockstepTest(WaitUntil, unittest.TestCase):
     def setUp(self):
         self.rsu_id = rospy.get_param("~rsu_id", "slow_rsu")
         self.delay_s = rospy.get_param("~answer_delay_s", 0.05)
@@ -53,14 +59,11 @@ class LockstepTest(unittest.TestCase):
         with self.lock:
             self.mode = mode
             start = len(self.arrivals)
-        end = time.monotonic() + 60.0
-        while time.monotonic() < end:
-            with self.lock:
-                if len(self.arrivals) >= start + steps:
-                    phase = [a for a in self.arrivals[start:start + steps] if a[2] == mode]
-                    return [b[0] - a[0] for a, b in zip(phase, phase[1:])]
-            time.sleep(0.01)
-        self.fail("phase %s: the bridge stopped publishing" % mode)
+        self.wait_until(lambda: len(self.arrivals) >= start + steps,
+                        "%d steps of phase %s (did the bridge stop publishing?)" % (steps, mode))
+        with self.lock:
+            phase = [a for a in self.arrivals[start:start + steps] if a[2] == mode]
+        return [b[0] - a[0] for a, b in zip(phase, phase[1:])]
 
     def late_steps(self):
         with self.lock:
@@ -80,9 +83,7 @@ class LockstepTest(unittest.TestCase):
         # Answering again at once: the pace recovers (the RSU is still live).
         self.assertLess(fast, 0.5 * self.deadline_s)
         # Late steps were counted (metrics_period_s is one step here).
-        end = time.monotonic() + 10.0
-        while time.monotonic() < end and (self.late_steps() or 0) < late_before + 10:
-            time.sleep(0.05)
+        poll(lambda: (self.late_steps() or 0) >= late_before + 10, 10.0, interval_s=0.05)
         self.assertGreaterEqual(self.late_steps() or 0, late_before + 10)
 
 

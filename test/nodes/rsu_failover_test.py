@@ -3,7 +3,9 @@
 quorum (quorum 1 of 2 here, deadline 5 s), the surviving RSU loads the new global model and
 keeps advising, and the bridge keeps stepping without the lost RSU.
 """
+import os
 import subprocess
+import sys
 import threading
 import time
 import unittest
@@ -13,10 +15,17 @@ import rostest
 from palcas_msgs.msg import AdvisoryArray, ModelWeights, VehicleStateArray
 from std_msgs.msg import UInt32
 
+# waiting.py beside this file (catkin's devel relay runs this file from elsewhere).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from waiting import WaitUntil  # noqa: E402
+
 WALL_TIMEOUT_S = 240.0
 
 
-class RsuFailoverTest(unittest.TestCase):
+class RsuFailoverTest(WaitUntil, unittest.TestCase):
+    WALL_TIMEOUT_S = WALL_TIMEOUT_S
+    POLL_S = 0.05
+
     def setUp(self):
         self.lock = threading.Lock()
         self.advice = {"rsu_0": [], "rsu_1": []}  # wall times of non-empty decisions
@@ -44,15 +53,6 @@ class RsuFailoverTest(unittest.TestCase):
     def on_states(self, msg):
         with self.lock:
             self.last_state_wall = time.monotonic()
-
-    def wait_until(self, condition, what):
-        end = time.monotonic() + WALL_TIMEOUT_S
-        while time.monotonic() < end and not rospy.is_shutdown():
-            with self.lock:
-                if condition():
-                    return
-            time.sleep(0.05)
-        self.fail("timed out waiting for " + what)
 
     def test_round_closes_on_quorum_and_the_survivor_keeps_advising(self):
         self.wait_until(lambda: len(self.advice["rsu_1"]) >= 3 and self.version == 1,

@@ -17,7 +17,4 @@ endforeach()
 # A user's own road (config/scenarios/curved): the road found in its network, its routes, the
 # errors; and the session driving it in-process (libsumo: its own executable).
 palcas_sim_add_gtest(own_road_test test/own_road_test.cpp)
-palcas_sim_add_gtest(own_road_session_test test/own_road_session_test.cpp)
-if(TARGET own_road_session_test)
-  target_link_libraries(own_road_session_test palcas_sim_libsumo)
-endif()
+palcas_sim_add_session_gtest(own_road_session_test test/own_road_session_test.cpp)

@@ -35,8 +35,9 @@ std::string readText(const std::string& path) {
 }
 
 uint32_t asUint32(const json::Value& v, const std::string& what) {
-  const uint64_t x = v.asUint(what);
-  if (x < 1 || x > UINT32_MAX) throw std::runtime_error(what + " = " + v.text + " is outside [1, 2^32)");
+  const uint64_t x = json::asUint(v, what);
+  if (x < 1 || x > UINT32_MAX)
+    throw std::runtime_error(what + " = " + std::to_string(x) + " is outside [1, 2^32)");
   return static_cast<uint32_t>(x);
 }
 
@@ -77,13 +78,16 @@ void FederationServer::saveCheckpoint(const std::string& dir) const {
 void FederationServer::loadCheckpoint(const std::string& dir) {
   const std::string state_path = dir + "/" + STATE_FILE;
   const json::Value st = json::parse(readText(state_path), state_path);
-  auto key = [&](const char* k) -> const json::Value& { return st.at(k, state_path); };
+  auto key = [&](const char* k) -> const json::Value& { return json::at(st, k, state_path); };
   auto name = [&](const char* k) { return state_path + ": '" + k + "'"; };
-  if (key("format").asString(name("format")) != STATE_FORMAT)
+  auto uintOf = [&](const char* k) { return json::asUint(key(k), name(k)); };
+  const std::string& format = json::asString(key("format"), name("format"));
+  if (format != STATE_FORMAT)
     throw std::runtime_error(state_path + ": not a PALCAS federation state file (format '" +
-                             key("format").text + "')");
-  if (key("format_version").asUint(name("format_version")) != STATE_FORMAT_VERSION)
-    throw std::runtime_error(state_path + ": format_version " + key("format_version").text +
+                             format + "')");
+  const uint64_t format_version = uintOf("format_version");
+  if (format_version != STATE_FORMAT_VERSION)
+    throw std::runtime_error(state_path + ": format_version " + std::to_string(format_version) +
                              " is not supported (expected " +
                              std::to_string(STATE_FORMAT_VERSION) + ")");
   const uint32_t round = asUint32(key("round"), name("round"));
@@ -93,33 +97,40 @@ void FederationServer::loadCheckpoint(const std::string& dir) {
                              " > round " + std::to_string(round));
   const std::string model_path = dir + "/" + MODEL_FILE;
   ModelBlob model = loadModelBlob(model_path);  // runtime_error on any file check
-  if (model.values.empty() || model.values.size() != key("model_value_count").asUint(name("model_value_count")) ||
-      valuesChecksum(model) != key("model_values_fnv1a64").asUint(name("model_values_fnv1a64")))
+  if (model.values.empty() || model.values.size() != uintOf("model_value_count") ||
+      valuesChecksum(model) != uintOf("model_values_fnv1a64"))
     throw std::runtime_error(model_path + " is not the model " + state_path +
                              " was written with (value count or checksum differs)");
   uint64_t rejected[REJECTION_COUNT] = {};
   const json::Value& by_reason = key("rejected_by_reason");
+  if (!by_reason.is_object())
+    throw std::runtime_error(name("rejected_by_reason") + " must be an object, got " +
+                             json::shown(by_reason));
   // A reason added after the file was written (update_too_large, unauthenticated) counts 0;
   // an unknown one means the file is not ours.
-  size_t known = 0;
   for (size_t i = 0; i < REJECTION_COUNT; ++i) {
     const char* reason = rejectionName(static_cast<Rejection>(i));
-    const bool present = std::any_of(by_reason.members.begin(), by_reason.members.end(),
-                                     [reason](const auto& m) { return m.first == reason; });
+    const bool present = by_reason.contains(reason);
     const bool optional = static_cast<Rejection>(i) == Rejection::kUpdateTooLarge ||
                           static_cast<Rejection>(i) == Rejection::kUnauthenticated;
     if (!present && optional) continue;
-    rejected[i] = by_reason.at(reason, name("rejected_by_reason")).asUint(name(reason));
-    ++known;
+    rejected[i] =
+        json::asUint(json::at(by_reason, reason, name("rejected_by_reason")), name(reason));
   }
-  if (by_reason.members.size() != known)
-    throw std::runtime_error(state_path + ": 'rejected_by_reason' holds unknown reasons");
-  const uint64_t fetch_unknown = key("fetch_unknown_rsu").asUint(name("fetch_unknown_rsu"));
-  const uint64_t accepted = key("accepted_total").asUint(name("accepted_total"));
-  const uint64_t closed = key("rounds_closed").asUint(name("rounds_closed"));
-  const uint64_t failed = key("failed_aggregations").asUint(name("failed_aggregations"));
-  const double last_s = key("last_round_s").asDouble(name("last_round_s"));
-  const uint64_t last_bytes = key("bytes_in_last_round").asUint(name("bytes_in_last_round"));
+  for (const auto& item : by_reason.items()) {
+    bool ours = false;
+    for (size_t i = 0; i < REJECTION_COUNT && !ours; ++i)
+      ours = item.key() == rejectionName(static_cast<Rejection>(i));
+    if (!ours)
+      throw std::runtime_error(state_path + ": 'rejected_by_reason' holds an unknown reason '" +
+                               item.key() + "'");
+  }
+  const uint64_t fetch_unknown = uintOf("fetch_unknown_rsu");
+  const uint64_t accepted = uintOf("accepted_total");
+  const uint64_t closed = uintOf("rounds_closed");
+  const uint64_t failed = uintOf("failed_aggregations");
+  const double last_s = json::asDouble(key("last_round_s"), name("last_round_s"));
+  const uint64_t last_bytes = uintOf("bytes_in_last_round");
 
   // Every check passed: commit.
   initialize(std::move(model));

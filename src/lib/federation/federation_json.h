@@ -1,43 +1,42 @@
 #pragma once
-// Minimal JSON for the federation server's state file and status line (private to the
-// core: no JSON dependency for one small flat file). Reads standard JSON; numbers keep
-// their text so 64-bit counters round-trip exactly.
+// JSON for the federation server's state file and status line (private to the core's
+// federation folder; nlohmann-json is header-only, so nothing of it reaches the installed
+// headers). nlohmann reads and escapes; these helpers add what the server's refusals need:
+// every failure names the file and the key, and reading a value never changes anything held.
 
 #include <cstdint>
 #include <string>
-#include <utility>
-#include <vector>
+
+#include <nlohmann/json.hpp>
 
 namespace palcas::json {
 
-struct Value {
-  enum class Type { kNull, kBool, kNumber, kString, kArray, kObject };
-  Type type = Type::kNull;
-  bool boolean = false;
-  std::string text;                                     ///< number text or string value
-  std::vector<Value> items;                             ///< array elements
-  std::vector<std::pair<std::string, Value>> members;   ///< object members, in file order
+using Value = nlohmann::json;
 
-  /// Member `key` of an object; throws std::runtime_error "<what>: missing key 'key'"
-  /// (or "not an object").
-  const Value& at(const std::string& key, const std::string& what) const;
-  /// This number as an unsigned integer (digits only, fits in 64 bits), or throws
-  /// std::runtime_error naming `what`.
-  uint64_t asUint(const std::string& what) const;
-  /// This number as a finite double, or throws std::runtime_error naming `what`.
-  double asDouble(const std::string& what) const;
-  /// This string, or throws std::runtime_error naming `what`.
-  const std::string& asString(const std::string& what) const;
-};
-
-/// Parses one JSON document (trailing whitespace allowed). Throws std::runtime_error
-/// "<what>: not valid JSON at byte N: ..." on any syntax error.
+/// Parses one JSON document (surrounding whitespace allowed). Throws std::runtime_error
+/// "<what>: not valid JSON at byte N: ..." on any syntax error or a number no double holds.
 Value parse(const std::string& text, const std::string& what);
 
-/// `text` as a quoted JSON string, with ", \ and control characters escaped.
+/// Member `key` of `object`; throws std::runtime_error "<what>: missing key 'key'" (or
+/// "<what>: not a JSON object").
+const Value& at(const Value& object, const std::string& key, const std::string& what);
+/// `value` as an unsigned integer (a JSON number without sign, fraction or exponent that fits
+/// in 64 bits), or throws std::runtime_error "<what> must be an unsigned integer, got ...".
+uint64_t asUint(const Value& value, const std::string& what);
+/// `value` as a finite double (any JSON number), or throws std::runtime_error naming `what`.
+double asDouble(const Value& value, const std::string& what);
+/// `value` as a string, or throws std::runtime_error naming `what`.
+const std::string& asString(const Value& value, const std::string& what);
+/// `value` for an error message: a scalar as its JSON text, an array or object by its type
+/// (a hostile file's deep nesting is never printed).
+std::string shown(const Value& value);
+
+/// `text` as a quoted JSON string: ", \ and control characters escaped, bytes that are not
+/// UTF-8 replaced by U+FFFD (an RSU id comes from the network).
 std::string quote(const std::string& text);
 
-/// A double in JSON: shortest round-tripping form (%.17g); non-finite -> null.
+/// A double in JSON: %.17g (round-trips exactly; the files written so far use it);
+/// non-finite -> null.
 std::string number(double value);
 
 }  // namespace palcas::json

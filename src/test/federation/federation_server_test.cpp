@@ -370,6 +370,118 @@ TEST(FederationServer, LoadCheckpointRefusesWhatIsNotOursAndKeepsState) {
   expectRefused(other, "not a PALCAS model file");
 }
 
+namespace {
+
+std::string readAll(const std::string& path) {
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  return text.str();
+}
+
+// `text` with its one occurrence of `from` replaced by `to` (fails the test if not once).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " not in " << text;
+  EXPECT_EQ(text.find(from, at + 1), std::string::npos) << from << " twice in " << text;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+}  // namespace
+
+TEST(FederationServer, LoadCheckpointNamesTheKeyOfAMissingOrWrongValueAndKeepsState) {
+  const std::string dir = tempDir("bad_values");
+  FederationServer o(abcOptions());
+  o.initialize(blob({7, 7, 7}));
+  o.saveCheckpoint(dir);
+  const std::string path = dir + "/" + FederationServer::STATE_FILE;
+  const std::string good = readAll(path);
+  FederationServer s = liveAbcServer();
+  s.submit("a", 1, 1, blob({4, -2, 1}), 1, 1.0);
+  const std::string before = federationStatusJson(s.status());
+  const struct {
+    std::string from, to, needle;
+  } cases[] = {
+      {"  \"accepted_total\": 0,\n", "", "missing key 'accepted_total'"},
+      {"\"round\": 1,", "\"round\": \"1\",", "'round' must be an unsigned integer, got '\"1\"'"},
+      {"\"rounds_closed\": 0", "\"rounds_closed\": -1", "'rounds_closed' must be an unsigned integer, got '-1'"},
+      {"\"global_version\": 1", "\"global_version\": 1.5", "'global_version' must be an unsigned integer"},
+      {"\"global_version\": 1", "\"global_version\": 1e0", "'global_version' must be an unsigned integer"},
+      {"\"round\": 1,", "\"round\": 4294967296,", "'round' = 4294967296 is outside [1, 2^32)"},
+      {"\"round\": 1,", "\"round\": 0,", "'round' = 0 is outside [1, 2^32)"},
+      {"\"fetch_unknown_rsu\": 0", "\"fetch_unknown_rsu\": 18446744073709551616",
+       "'fetch_unknown_rsu' must be an unsigned integer"},
+      {"\"failed_aggregations\": 0", "\"failed_aggregations\": [0]",
+       "'failed_aggregations' must be an unsigned integer, got a JSON array"},
+      {"\"last_round_s\": 0", "\"last_round_s\": null", "'last_round_s' must be a finite number, got 'null'"},
+      {"\"last_round_s\": 0", "\"last_round_s\": 1e999", "not valid JSON"},
+      {"\"format\": \"palcas_federation_state\"", "\"format\": 3", "'format' must be a string, got '3'"},
+      {"\"format_version\": 1", "\"format_version\": 2", "format_version 2 is not supported"},
+      {"\"global_version\": 1", "\"global_version\": 2", "global_version 2 > round 1"},
+      {"\"duplicate\":0", "\"duplicate\":\"0\"", "'duplicate' must be an unsigned integer"},
+      {"\"duplicate\":0", "\"duplicated\":0", "missing key 'duplicate'"},
+      {"\"duplicate\":0,", "\"duplicate\":0,\"tampered\":0,", "'rejected_by_reason' holds an unknown reason 'tampered'"},
+      {"\"rejected_by_reason\": {", "\"rejected_by_reason\": \"none\", \"x\": {",
+       "'rejected_by_reason' must be an object, got '\"none\"'"},
+      {"\n}\n", "\n} x\n", "not valid JSON at byte"},
+      {"\"model_file\"", "\"model_file", "not valid JSON at byte"},
+      {"\"round\": 1,", "\"round\": 1,,", "not valid JSON at byte"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.to);
+    std::ofstream(path) << replaced(good, c.from, c.to);
+    expectThrowMentioning<std::runtime_error>([&] { s.loadCheckpoint(dir); }, c.needle);
+    EXPECT_EQ(federationStatusJson(s.status()), before);
+    EXPECT_EQ(s.globalModel()->values, (std::vector<float>{1, 2, 3}));
+  }
+  for (const std::string& text : {std::string(""), std::string("[1, 2]"), good.substr(0, good.size() / 2)}) {
+    SCOPED_TRACE(text);
+    std::ofstream(path) << text;
+    expectThrowMentioning<std::runtime_error>([&] { s.loadCheckpoint(dir); }, path);
+    EXPECT_EQ(federationStatusJson(s.status()), before);
+  }
+  std::ofstream(path) << good;  // and the untouched file loads
+  s.loadCheckpoint(dir);
+  EXPECT_EQ(s.globalModel()->values, (std::vector<float>{7, 7, 7}));
+}
+
+TEST(FederationServer, TheShippedPoliciesStateFilesLoadAndSaveByteForByte) {
+  // The state files committed with the shipped policies (their models are not committed: a
+  // small one stands in, named by count and checksum). Loading one and saving it again gives
+  // the same bytes, so old and new files read alike.
+  const std::filesystem::path policies = PALCAS_POLICIES_DIR;
+  int found = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(policies)) {
+    const auto state = entry.path() / "checkpoints/fedserver" / FederationServer::STATE_FILE;
+    if (!std::filesystem::exists(state)) continue;
+    SCOPED_TRACE(state.string());
+    ++found;
+    const std::string text = readAll(state.string());
+    const ModelBlob model = blob({7, 7, 7});
+    const std::string count = "\"model_value_count\": " + std::to_string(model.values.size());
+    const std::string checksum =
+        "\"model_values_fnv1a64\": " +
+        std::to_string(nn::fnv1a64(model.values.data(), model.values.size() * sizeof(float)));
+    const auto field = [&](const std::string& key) {  // `"key": value` as the file has it
+      const auto at = text.find("\"" + key + "\": ");
+      return text.substr(at, text.find(',', at) - at);
+    };
+    const std::string stand_in =
+        replaced(replaced(text, field("model_value_count"), count), field("model_values_fnv1a64"), checksum);
+    const std::string dir = tempDir("shipped_" + entry.path().filename().string());
+    FederationServer writer(abcOptions());
+    writer.initialize(model);
+    writer.saveCheckpoint(dir);  // the stand-in model file
+    std::ofstream(dir + "/" + FederationServer::STATE_FILE) << stand_in;
+    FederationServer r(abcOptions());
+    r.loadCheckpoint(dir);
+    EXPECT_GE(r.round(), 1u);
+    const std::string again = tempDir("shipped_again");
+    r.saveCheckpoint(again);
+    EXPECT_EQ(readAll(again + "/" + FederationServer::STATE_FILE), stand_in);
+  }
+  EXPECT_GE(found, 1) << "no shipped federation state under " << policies;
+}
+
 TEST(FederationServer, ARefusalFromTheNodeIsCountedAndChangesNothingElse) {
   FederationServer s = liveAbcServer();
   const std::string before = federationStatusJson(s.status());

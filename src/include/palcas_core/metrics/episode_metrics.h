@@ -124,7 +124,6 @@ class EpisodeMetricsAccumulator {
   void reset();
 
  private:
-  enum class Outcome { kUndecided, kSucceeded, kFailed };
   struct Vehicle {
     bool is_cav = false;
     RouteKind route_kind = RouteKind::kMainThrough;

@@ -82,8 +82,6 @@ class OutcomeTracker {
   void reset();
 
  private:
-  enum class Outcome { kUndecided, kSucceeded, kFailed };
-
   /// What the tracker remembers of one vehicle; route facts are frozen at first sight, so the
   /// bridge re-routing a vehicle after a missed exit does not change its outcome.
   struct Tracked {

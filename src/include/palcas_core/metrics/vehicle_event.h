@@ -31,6 +31,10 @@ enum class VehicleEventKind : int {
 };
 constexpr int VEHICLE_EVENT_KIND_COUNT = 8;
 
+/// Where a vehicle's exit or merge stands. The outcome tracker (which emits the events) and
+/// the episode metrics (which count them) each decide one at most once per vehicle.
+enum class Outcome { kUndecided, kSucceeded, kFailed };
+
 /// One event of one vehicle (mirrors palcas_msgs/VehicleEvent).
 struct VehicleEvent {
   std::string vehicle_id;

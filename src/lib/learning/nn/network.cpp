@@ -4,12 +4,11 @@
 #include <stdexcept>
 
 #include "checks.h"
+#include "palcas_core/learning/nn/activation.h"
 #include "palcas_core/learning/nn/batch_norm.h"
 #include "palcas_core/learning/nn/dropout.h"
 #include "palcas_core/learning/nn/linear.h"
-#include "palcas_core/learning/nn/relu.h"
 #include "palcas_core/learning/nn/serialization.h"
-#include "palcas_core/learning/nn/tanh.h"
 
 namespace palcas::nn {
 

@@ -7,13 +7,12 @@
 #include <vector>
 
 #include "nn_test_util.h"
+#include "palcas_core/learning/nn/activation.h"
 #include "palcas_core/learning/nn/adamw.h"
 #include "palcas_core/learning/nn/batch_norm.h"
 #include "palcas_core/learning/nn/dropout.h"
 #include "palcas_core/learning/nn/linear.h"
 #include "palcas_core/learning/nn/network.h"
-#include "palcas_core/learning/nn/relu.h"
-#include "palcas_core/learning/nn/tanh.h"
 
 using namespace palcas;
 using namespace palcas::nn;

@@ -5,9 +5,9 @@
 #include <limits>
 
 #include "nn_test_util.h"
+#include "palcas_core/learning/nn/activation.h"
 #include "palcas_core/learning/nn/batch_norm.h"
 #include "palcas_core/learning/nn/linear.h"
-#include "palcas_core/learning/nn/tanh.h"
 
 using namespace palcas;
 using namespace palcas::nn;

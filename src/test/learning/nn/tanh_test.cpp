@@ -1,4 +1,4 @@
-#include "palcas_core/learning/nn/tanh.h"
+#include "palcas_core/learning/nn/activation.h"
 
 #include <gtest/gtest.h>
 
