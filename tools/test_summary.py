@@ -77,8 +77,9 @@ def main():
         if catkin_failed and not failed:
             print("  FAILED catkin_test_results: a failure or error no <testcase> shows")
             failed += 1
-    tail = f", {skipped} skipped" if skipped else ""
-    print(f"{passed} passed, {failed} failed{tail}")
+    if skipped:  # on its own line: the last one must stay exactly 'N passed, N failed'
+        print(f"{skipped} skipped")
+    print(f"{passed} passed, {failed} failed")
     return 1 if failed or passed == 0 else 0
 
 
