@@ -54,7 +54,7 @@ HELPS = {
     "--no-trajectories": (None, D("record no trajectories.csv / decisions.csv (and draw no figures)",
                                   "off: every %d steps" % DEFAULTS["trajectory_steps"])),
     "--in-process": (None, D("run the RSUs inside the bridge process (the same decision code, a call per step "
-                             "instead of ROS topics; same results, faster)", "off: one RSU node per zone")),
+                             "instead of ROS topics; same results; on two cores no faster, as measured)", "off: one RSU node per zone")),
     "--bridge-params": ("FILE", D("a bridge parameter override for every arm", "none")),
     "--rsu-params": ("FILE", D("an RSU parameter override for every RSU (e.g. a rules: map over "
                                "config/rules.yaml)", "none")),
