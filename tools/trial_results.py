@@ -11,7 +11,8 @@ Input: a folder holding one or more results.csv files of ./palcas experiment (FO
 and FOLDER/*/results.csv, merged; a point in two files is an error) and optionally
 FOLDER/trial.json naming the settings (the keys of an experiment.json: arms, prs, demands,
 seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, git_commit,
-printed as they are). Without trial.json the grid is what the rows hold.
+printed as they are; seeds_by_demand, {"1400": [seeds], ...}, for a part run with fewer seeds
+than the trial's list). Without trial.json the grid is what the rows hold.
 
 The page: what was run (failed and missing points named); each arm's mechanisms (the
 registry config/arms.json and the bridge parameters it runs under: config/bridge.yaml, then
@@ -398,6 +399,15 @@ def trial_grid(rows, settings, registry):
     return arms, seeds, cells
 
 
+def seeds_for(settings, cell, seeds):
+    """The seeds planned for `cell`: trial.json's seeds_by_demand for its demand (a part run
+    with fewer seeds), else the trial's list."""
+    by_demand = settings.get("seeds_by_demand") or {}
+    d = cell[0]
+    key = "scenario" if d is None else (str(int(d)) if float(d).is_integer() else str(d))
+    return sorted(by_demand[key]) if key in by_demand else seeds
+
+
 def in_grid(rows, settings, registry):
     """(rows in the trial's grid, rows outside it): trial.json's arms, seeds and cells when it
     names them."""
@@ -424,9 +434,10 @@ def analyse(rows, settings, registry):
         for L, C in order:
             if not (per_arm[L]["n"] and per_arm[C]["n"]):
                 continue
+            planned = seeds_for(settings, cell, seeds)
             comparisons.append({"learned": L, "control": C, "best": C == best,
-                                "ratio": compare(rows, L, C, cell, SPEED, seeds, ratio=True),
-                                "metrics": [compare(rows, L, C, cell, m, seeds) for m in PAIRED]})
+                                "ratio": compare(rows, L, C, cell, SPEED, planned, ratio=True),
+                                "metrics": [compare(rows, L, C, cell, m, planned) for m in PAIRED]})
         result["cells"].append({"cell": cell, "arms": per_arm, "best": best, "best_speed": speeds.get(best),
                                 "comparisons": comparisons})
     return result
@@ -517,12 +528,16 @@ def what_was_run(rows, files, settings, folder, a):
     lines.append(f"- Seeds ({len(seeds)}, {set_text}): {', '.join(str(s) for s in seeds)}")
     if settings.get("bridge_params"):
         lines.append(f"- Every point under the bridge override `{settings['bridge_params']}`")
-    expected = [(arm, c, s) for arm in arms for c in (x["cell"] for x in a["cells"]) for s in seeds]
+    for key, planned in sorted((settings.get("seeds_by_demand") or {}).items()):
+        lines.append(f"- Seeds at {key} veh/h/lane: {len(planned)} planned, {', '.join(str(x) for x in planned)}")
+    expected = [(arm, c, s) for arm in arms for c in (x["cell"] for x in a["cells"])
+                for s in seeds_for(settings, c, seeds)]
     have = {(r["arm"], (r["demand"], r["pr"]), r["seed"]): r for r in rows}
     done = sum(1 for k in expected if k in have and have[k]["status"] == "done")
     extra = in_grid(rows, settings, load_registry())[1]
+    per_cell = "their seeds" if settings.get("seeds_by_demand") else f"{len(seeds)} seeds"
     lines.append(f"- Points: {len(expected)} planned ({len(arms)} arms × {len(a['cells'])} cells × "
-                 f"{len(seeds)} seeds), {done} finished")
+                 f"{per_cell}), {done} finished")
     bad = []
     for arm, cell, seed in expected:
         r = have.get((arm, cell, seed))

@@ -180,6 +180,22 @@ class CellTest(unittest.TestCase):
         self.assertEqual(high["arms"]["palcas"]["metrics"]["unserved_vehicles"]["worst_seed"], 1002)
 
 
+class SeedsByDemandTest(unittest.TestCase):
+    def test_a_part_run_with_fewer_seeds_is_paired_and_counted_on_its_own(self):
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings["seeds_by_demand"] = {"2200": [1001, 1002]}
+        self.assertEqual(trial_results.seeds_for(settings, HIGH, SEEDS), [1001, 1002])
+        self.assertEqual(trial_results.seeds_for(settings, LOW, SEEDS), SEEDS)
+        a = trial_results.analyse(fixture_rows(), settings, trial_results.load_registry())
+        high = [c for c in a["cells"] if c["cell"] == HIGH][0]
+        vs_native = [x for x in high["comparisons"] if x["control"] == "sumo_native"][0]["ratio"]
+        self.assertEqual(vs_native["n"], 2)
+        self.assertNotIn(1003, [seed for seed, _ in vs_native["left_out"]], "1003 is not planned there")
+        lines = trial_results.what_was_run(fixture_rows(), [FIXTURE / "results.csv"], settings, FIXTURE, a)
+        self.assertIn("- Seeds at 2200 veh/h/lane: 2 planned, 1001, 1002", lines)
+        self.assertFalse([l for l in lines if "2200" in l and "s1003" in l], "no missing point outside the plan")
+
+
 class MechanismTest(unittest.TestCase):
     def test_the_real_registry(self):
         import yaml
