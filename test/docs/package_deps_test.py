@@ -39,7 +39,7 @@ PACKAGE_DIRS = ["src", "palcas_msgs", "palcas_common", "palcas_rsu", "palcas_fed
 ROSDEP = {"Eigen3": "eigen", "OpenSSL": "libssl-dev", "nlohmann_json": "nlohmann-json-dev",
           "GTest": "gtest", "rostest": "rostest", "catkin": None, "OpenMP": None}
 # Include prefixes that are no ROS package: the C++ and system libraries, or inside another.
-NOT_PACKAGES = {"sys", "openssl", "nlohmann", "gtest", "ros", "xmlrpcpp", "libsumo", "Eigen",
+NOT_PACKAGES = {"sys", "netinet", "openssl", "nlohmann", "gtest", "ros", "xmlrpcpp", "libsumo", "Eigen",
                 "benchmark", "boost", "gmock"}
 # A header folder that belongs to another package.
 INCLUDE_PACKAGE = {"libsumo": "sumo", "nlohmann": "nlohmann-json-dev", "openssl": "libssl-dev",

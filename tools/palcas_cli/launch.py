@@ -2,6 +2,7 @@
 master port, the message key, the console log, the parent-death signal, SIGINT/SIGTERM), and
 every command reads its console with node_deaths / last_fatal: a command whose nodes died
 never reports success."""
+import importlib.machinery
 import os
 import re
 import signal
@@ -10,6 +11,7 @@ import subprocess
 import sys
 import threading
 import time
+import types
 
 from palcas_cli import ROOT
 
@@ -45,13 +47,14 @@ def ros_env(port, log_dir=None):
 def message_key(folder):
     """<folder>/auth.key: the run's or training's random message key (palcas_common/README.md),
     made on first use by the launch package's scripts/message_key (the one that system.launch
-    runs by default). Every node of the run reads it: RSUs sign advisories and submissions, the
-    bridge and the server refuse the rest."""
-    script = os.path.join(ROOT, "launch", "scripts", "message_key")
-    done = subprocess.run([script, folder], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if done.returncode != 0:
-        raise OSError(done.stderr.strip() or "%s failed" % script)
-    return done.stdout
+    runs by default), loaded as a module: one implementation, no child process. Every node of
+    the run reads it: RSUs sign advisories and submissions, the bridge and the server refuse
+    the rest."""
+    loader = importlib.machinery.SourceFileLoader("palcas_message_key",
+                                                  os.path.join(ROOT, "launch", "scripts", "message_key"))
+    module = types.ModuleType(loader.name)
+    loader.exec_module(module)
+    return module.make(folder)
 
 
 def git_commit():
