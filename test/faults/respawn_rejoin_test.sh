@@ -40,6 +40,9 @@ wait_for 180 test -f "$OUT/checkpoints/rsu_0/controller.txt" || why="rsu_0 wrote
 rsu_pid="$(pid_of rsu_node rsu_0)"
 [ -n "$why" ] || [ -n "$rsu_pid" ] || why="no rsu_0 process"
 [ -n "$why" ] || kill -9 "$rsu_pid"
+aborted() {  # why the training's episode ended early, as the training recorded it
+  [ -f "$OUT/aborted_episodes.txt" ] && tr '\n' ' ' <"$OUT/aborted_episodes.txt"
+}
 log() { sed 's/\x1b\[[0-9;]*m//g' "$OUT/console.log" "$OUT"/ros_log/latest/rosout.log 2>/dev/null; }
 [ -n "$why" ] || wait_for 60 bash -c "[ \"\$(sed 's/\x1b\[[0-9;]*m//g' '$OUT/console.log' | grep -ac 'RSU .rsu_0. registered')\" -ge 2 ]" ||
   why="rsu_0 did not register with the bridge again"
@@ -60,7 +63,7 @@ closed_after() {  # a round numbered above the one before the kill closed with b
     awk -v r="$round_before" '{ if ($2 + 0 > r + 1) found = 1 } END { exit !found }'
 }
 [ -n "$why" ] || wait_for 150 closed_after ||
-  why="no round after $((round_before + 1)) closed with both RSUs after the restart (RSUs did not rejoin, or numbering restarted)"
+  why="no round after $((round_before + 1)) closed with both RSUs after the restart (RSUs did not rejoin, or numbering restarted) $(aborted)"
 [ -n "$why" ] || [ "$(sed 's/\x1b\[[0-9;]*m//g' "$OUT"/ros_log/latest/rosout.log | grep -ac 'round 1 closed')" -le 1 ] ||
   why="round numbering started again at 1"
 result server_sigkill_restarted_rounds_continue "$why"
@@ -70,7 +73,7 @@ status=0
 wait "$train_pid" || status=$?
 train_pid=""
 why=""
-[ "$status" -eq 0 ] || why="./palcas train exited $status: $(grep -a error "$WORK/train.log" | head -2)"
+[ "$status" -eq 0 ] || why="./palcas train exited $status: $(grep -a error "$WORK/train.log" | head -2) $(aborted)"
 [ -n "$why" ] || [ "$(($(wc -l <"$OUT/episodes.csv") - 1))" -eq 1 ] || why="episodes.csv does not hold exactly one episode"
 result training_succeeds_once "$why"
 

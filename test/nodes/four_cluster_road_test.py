@@ -69,15 +69,18 @@ class FourClusterRoadTest(unittest.TestCase):
         advised_x = {r: [] for r in rsus}
         lanes_seen, num_lanes = set(), set()
         with rosbag.Bag(out + "/run/episode.bag") as bag:
-            last_x = {}
+            # Positions by step: an advisory answers the state of its own `step`, which on a
+            # loaded machine need not be the last state recorded before it.
+            x_at_step = {}
             for topic, msg, _ in bag.read_messages(topics=["/vehicle_states", "/advisories"]):
                 if topic == "/vehicle_states":
                     num_lanes.add(msg.num_lanes)
-                    last_x = {v.id: v.x_m for v in msg.vehicles}
+                    x_at_step[msg.step] = {v.id: v.x_m for v in msg.vehicles}
                     lanes_seen.update(v.lane for v in msg.vehicles)
                 else:
                     self.assertIn(msg.rsu_id, rsus, "an advisory from an RSU the road does not have")
-                    advised_x[msg.rsu_id] += [last_x[a.vehicle_id] for a in msg.advisories if a.vehicle_id in last_x]
+                    x = x_at_step.get(msg.step, {})  # a state the recorder dropped: not judged
+                    advised_x[msg.rsu_id] += [x[a.vehicle_id] for a in msg.advisories if a.vehicle_id in x]
         self.assertEqual(num_lanes, {LANES}, "the bridge's road has another lane count")
         self.assertIn(LANES, lanes_seen, "no vehicle on lane 4")
         for k, r in enumerate(rsus):
