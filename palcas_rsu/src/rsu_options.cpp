@@ -42,6 +42,8 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);
+  c.personal_head_layers = static_cast<size_t>(
+      p.integer("rsu/personal_head_layers", static_cast<int>(c.personal_head_layers), 0, 100));
   TerminalRewards& t = c.terminal;
   t.collision_penalty = p.number("rsu/collision_penalty", t.collision_penalty, 0.0, 1e9);
   t.exit_taken_bonus = p.number("rsu/exit_taken_bonus", t.exit_taken_bonus, 0.0, 1e9);

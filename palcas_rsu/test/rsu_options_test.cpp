@@ -123,6 +123,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "'magic', not one of network, rules");
   expectRefused("rule", [](ros::NodeHandle& nh) { nh.setParam("rules/exit_margin_m", -1.0); },
                 "rules/exit_margin_m");
+  expectRefused("head", [](ros::NodeHandle& nh) { nh.setParam("rsu/personal_head_layers", -1); },
+                "rsu/personal_head_layers");
 }
 
 int main(int argc, char** argv) {

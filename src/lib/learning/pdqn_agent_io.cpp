@@ -47,6 +47,27 @@ void PdqnAgent::importModel(const ModelBlob& blob) {
   q_.setState(blob.values.data() + mu_count, q_count);
 }
 
+std::vector<nn::Network::StateSpan> PdqnAgent::headSpans(size_t linear_layers) const {
+  std::vector<nn::Network::StateSpan> spans;
+  if (linear_layers == 0) return spans;
+  nn::Index offset = 0;
+  for (const nn::Network* net : {&mu_, &q_}) {
+    std::vector<size_t> linear;
+    for (size_t i = 0; i < net->layerCount(); ++i)
+      if (net->layer(i).typeName() == "Linear") linear.push_back(i);
+    if (linear_layers >= linear.size())
+      throw std::invalid_argument("PdqnAgent::headSpans: a head of " + std::to_string(linear_layers) +
+                                  " Linear layers, the network has " + std::to_string(linear.size()) +
+                                  " (at least one must stay shared)");
+    for (nn::Network::StateSpan span : net->stateSpansFrom(linear[linear.size() - linear_layers])) {
+      span.begin += offset;
+      spans.push_back(span);
+    }
+    offset += net->stateCount();
+  }
+  return spans;
+}
+
 void PdqnAgent::saveModel(const std::string& path) const { saveModelBlob(exportModel(), path); }
 
 void PdqnAgent::loadModel(const std::string& path) {

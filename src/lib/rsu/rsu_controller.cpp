@@ -80,7 +80,14 @@ const RsuControllerOptions& validated(const RsuControllerOptions& options) {
 RsuController::RsuController(const RsuControllerOptions& options)
     : options_(validated(options)),
       builder_(options.num_lanes, options.scales),
-      agent_(options.pdqn) {}
+      agent_(options.pdqn) {
+  try {
+    personal_head_ = agent_.headSpans(options.personal_head_layers);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("RsuControllerOptions: personal_head_layers " +
+                                std::to_string(options.personal_head_layers) + ": " + e.what());
+  }
+}
 
 bool RsuController::isMember(const VehicleSnapshot& v) const {
   // Zone [x_start, x_end); ramp / off-ramp vehicles (lane 0, not on the acceleration lane)

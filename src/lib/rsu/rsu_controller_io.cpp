@@ -150,7 +150,18 @@ void RsuController::loadGlobalModel(const ModelBlob& blob, uint32_t version) {
     throw std::invalid_argument("RsuController::loadGlobalModel: version " +
                                 std::to_string(version) + " is older than the current " +
                                 std::to_string(counters_.model_version));
-  agent_.importModel(blob);  // throws std::invalid_argument, agent untouched
+  if (personal_head_.empty()) {
+    agent_.importModel(blob);  // throws std::invalid_argument, agent untouched
+  } else {
+    // The federation's body under this RSU's own head. A blob of another shape is left to
+    // importModel's checks, which name what is wrong.
+    ModelBlob merged = blob;
+    const ModelBlob own = agent_.exportModel();
+    if (merged.layout_id == own.layout_id && merged.values.size() == own.values.size())
+      for (const nn::Network::StateSpan& span : personal_head_)
+        std::copy_n(own.values.begin() + span.begin, span.count, merged.values.begin() + span.begin);
+    agent_.importModel(merged);
+  }
   counters_.model_version = version;
   ++counters_.federation_round;
   counters_.samples_since_federation = 0;

@@ -553,6 +553,37 @@ TEST(RsuController, NoFederationWhenTheIntervalIsZero) {
   EXPECT_FALSE(c.federationDue());
 }
 
+TEST(RsuController, APersonalHeadStaysLocalWhenTheGlobalModelIsLoaded) {
+  RsuControllerOptions other = smallOptions();
+  other.pdqn.seed = 99;  // other weights, same layout
+  const ModelBlob global = RsuController(other).exportModel();
+  RsuControllerOptions o = smallOptions();
+  o.personal_head_layers = 1;
+  RsuController c(o);
+  const ModelBlob own = c.exportModel();
+  const auto head = c.agent().headSpans(1);
+  ASSERT_EQ(head.size(), 2u);  // each network's output Linear (no batch norm after it)
+  std::vector<bool> in_head(own.values.size(), false);
+  for (const auto& span : head)
+    for (auto i = span.begin; i < span.begin + span.count; ++i) in_head[static_cast<size_t>(i)] = true;
+  c.loadGlobalModel(global, 1);
+  const ModelBlob loaded = c.exportModel();
+  size_t kept = 0;
+  for (size_t i = 0; i < loaded.values.size(); ++i) {
+    ASSERT_EQ(loaded.values[i], in_head[i] ? own.values[i] : global.values[i]) << "value " << i;
+    kept += in_head[i] && own.values[i] != global.values[i];
+  }
+  EXPECT_GT(kept, 0u);  // the two heads differed, so keeping one is seen
+  EXPECT_EQ(c.modelVersion(), 1u);
+
+  RsuController whole(smallOptions());  // 0, the paper: the whole global model
+  whole.loadGlobalModel(global, 1);
+  EXPECT_EQ(whole.exportModel().values, global.values);
+
+  o.personal_head_layers = 3;  // hidden {16, 16}: three Linear layers, none left to share
+  expectInvalid([&] { RsuController refused(o); }, "personal_head_layers 3");
+}
+
 TEST(RsuController, RefusesABadGlobalModelAndKeepsTheLocalOne) {
   RsuControllerOptions other = smallOptions();
   other.pdqn.hidden_sizes = {8};

@@ -88,6 +88,11 @@ class PdqnAgent {
   /// Throws std::invalid_argument (agent untouched) on another layout id, a bad checksum,
   /// a wrong value count or a non-finite value (index named).
   void importModel(const ModelBlob& blob);
+  /// The model's head as spans of exportModel()'s values: in each network, the layers from
+  /// its `linear_layers`-th last Linear layer to the output (parameters and buffers). 0 =
+  /// none. Throws std::invalid_argument unless linear_layers is below each network's count
+  /// of Linear layers (a head that is the whole network leaves nothing to share).
+  std::vector<nn::Network::StateSpan> headSpans(size_t linear_layers) const;
   /// exportModel() to a model file / importModel() from one (std::runtime_error on error,
   /// agent untouched).
   void saveModel(const std::string& path) const;

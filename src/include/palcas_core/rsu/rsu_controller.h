@@ -52,6 +52,10 @@ struct RsuControllerOptions {
   /// Local gradient steps between federation rounds (paper E = 2500); 0 = never due
   /// (independent baseline).
   uint64_t federation_interval_steps = 2500;
+  /// Personalised federation: the last this-many Linear layers of each network (with what
+  /// follows them) stay the RSU's own when a global model is loaded; the rest (the shared
+  /// body) is the federation's. 0 (paper): the whole global model is loaded.
+  size_t personal_head_layers = 0;
   /// Rewards of collisions, exits taken or missed and failed merges (the paper defines
   /// none: all 0 / false by default; reward/terminal_rewards.h).
   TerminalRewards terminal;
@@ -179,8 +183,9 @@ class RsuController {
   ModelBlob exportModel() const { return agent_.exportModel(); }
   /// n_k: transitions stored since the last loadGlobalModel() (or construction).
   uint64_t samplesSinceFederation() const { return counters_.samples_since_federation; }
-  /// Imports the global model and starts a new round: clears the due flag and n_k,
-  /// sets the model version, counts the round. Throws std::invalid_argument (local model
+  /// Imports the global model (with personal_head_layers, all but this RSU's own head)
+  /// and starts a new round: clears the due flag and n_k, sets the model version, counts
+  /// the round. Throws std::invalid_argument (local model
   /// and counters kept) on another layout, a bad checksum, wrong size, non-finite value,
   /// or a version older than the current one.
   void loadGlobalModel(const ModelBlob& blob, uint32_t version);
@@ -229,6 +234,7 @@ class RsuController {
   RsuControllerOptions options_;
   StateBuilder builder_;
   PdqnAgent agent_;
+  std::vector<nn::Network::StateSpan> personal_head_;  ///< kept from the local model on loadGlobalModel
   TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;

@@ -117,6 +117,21 @@ Vector Network::getState() const {
   return out;
 }
 
+std::vector<Network::StateSpan> Network::stateSpansFrom(size_t first_layer) const {
+  if (first_layer > layers_.size())
+    throw std::out_of_range("Network::stateSpansFrom: layer " + std::to_string(first_layer) + " of " +
+                            std::to_string(layers_.size()));
+  Index params_before = 0, buffers_before = 0, params_after = 0, buffers_after = 0;
+  for (size_t i = 0; i < layers_.size(); ++i) {
+    (i < first_layer ? params_before : params_after) += layers_[i]->parameters().size();
+    (i < first_layer ? buffers_before : buffers_after) += layers_[i]->buffers().size();
+  }
+  std::vector<StateSpan> spans;
+  if (params_after > 0) spans.push_back({params_before, params_after});
+  if (buffers_after > 0) spans.push_back({parameterCount() + buffers_before, buffers_after});
+  return spans;
+}
+
 void Network::setState(const Scalar* values, Index count) {
   if (count != stateCount())
     throw std::invalid_argument("Network::setState: expected " + std::to_string(stateCount()) +

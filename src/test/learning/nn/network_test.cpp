@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <stdexcept>
 
 #include "nn_test_util.h"
 #include "palcas_core/learning/nn/activation.h"
@@ -110,6 +111,31 @@ TEST(Network, StateRoundTripAndDeepCopy) {
   copy.layer(0).parameters()[0] += 1.0f;
   EXPECT_NE(copy.getState(), a.getState());  // the copy owns its own layers
   EXPECT_EQ(copy.layout(), a.layout());
+}
+
+TEST(Network, StateSpansFromALayerCoverItsParametersThenItsBuffers) {
+  Rng rng(75);
+  MlpSpec spec;
+  spec.input_size = 3;
+  spec.hidden_sizes = {4};
+  spec.output_size = 2;
+  // Linear(3,4) 16 params; BatchNorm1d(4) 8 params + 8 buffers; ReLU; Dropout; Linear(4,2) 10.
+  const Network net = makeMlp(spec, rng);
+  ASSERT_EQ(net.parameterCount(), 34);
+  ASSERT_EQ(net.bufferCount(), 8);
+  auto spans = net.stateSpansFrom(4);  // the output Linear: parameters only
+  ASSERT_EQ(spans.size(), 1u);
+  EXPECT_EQ(spans[0].begin, 24);
+  EXPECT_EQ(spans[0].count, 10);
+  spans = net.stateSpansFrom(1);  // batch norm on: its parameters and the rest, then its buffers
+  ASSERT_EQ(spans.size(), 2u);
+  EXPECT_EQ(spans[0].begin, 16);
+  EXPECT_EQ(spans[0].count, 18);
+  EXPECT_EQ(spans[1].begin, 34);
+  EXPECT_EQ(spans[1].count, 8);
+  EXPECT_TRUE(net.stateSpansFrom(5).empty());
+  EXPECT_EQ(net.stateSpansFrom(0).size(), 2u);
+  EXPECT_THROW(net.stateSpansFrom(6), std::out_of_range);
 }
 
 TEST(Network, RejectsBadStateAndShapesLeavingItUnchanged) {

@@ -62,6 +62,15 @@ class Network {
   void setState(const Scalar* values, Index count);
   void setState(const Vector& values) { setState(values.data(), values.size()); }
 
+  /// Where layers [first_layer, layerCount()) sit in getState()'s order: their parameters'
+  /// span, then their buffers' span (empty spans left out). Throws std::out_of_range if
+  /// first_layer > layerCount(). What a personalised federation keeps local (a model's head).
+  struct StateSpan {
+    Index begin = 0;
+    Index count = 0;
+  };
+  std::vector<StateSpan> stateSpansFrom(size_t first_layer) const;
+
   /// Layer descriptions joined by ';', e.g. "Linear(45,256);BatchNorm1d(256);ReLU(256)".
   std::string layout() const;
   /// FNV-1a 64 of layout().
