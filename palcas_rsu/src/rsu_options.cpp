@@ -39,6 +39,8 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   r.exit_margin_m = p.number("rules/exit_margin_m", r.exit_margin_m, 0.0, 1e6);
   r.through_keep_out_lanes = p.integer("rules/through_keep_out_lanes", r.through_keep_out_lanes, 0, 100);
   r.advise_merge = p.get<bool>("rules/advise_merge", r.advise_merge);
+  c.rule_residual = p.get<bool>("rsu/rule_residual", c.rule_residual);
+  c.residual_margin = p.number("rsu/residual_margin", c.residual_margin, 0.0, 1e9);
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);

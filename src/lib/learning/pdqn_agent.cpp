@@ -134,12 +134,37 @@ void PdqnAgent::forwardGreedy(const nn::Matrix& states) {
 
 void PdqnAgent::act(const nn::Matrix& states, bool explore, std::vector<Decision>& out) {
   checkStates(states, "PdqnAgent::act");
+  decide(states, explore, nullptr, 0.0f, out);
+}
+
+void PdqnAgent::actOverDefaults(const nn::Matrix& states, bool explore, const std::vector<Decision>& defaults,
+                                float margin, std::vector<Decision>& out) {
+  checkStates(states, "PdqnAgent::actOverDefaults");
+  if (defaults.size() != static_cast<size_t>(states.cols()))
+    throw std::invalid_argument("PdqnAgent::actOverDefaults: " + std::to_string(defaults.size()) +
+                                " defaults for " + std::to_string(states.cols()) + " states");
+  if (!std::isfinite(margin) || margin < 0.0f)
+    throw std::invalid_argument("PdqnAgent::actOverDefaults: margin " + std::to_string(margin) +
+                                " must be finite and >= 0");
+  decide(states, explore, &defaults, margin, out);
+}
+
+void PdqnAgent::decide(const nn::Matrix& states, bool explore, const std::vector<Decision>* defaults, float margin,
+                       std::vector<Decision>& out) {
   forwardGreedy(states);
   out.resize(static_cast<size_t>(states.cols()));
   for (nn::Index j = 0; j < states.cols(); ++j) {
     nn::Index best = 0;
     act_q_.col(j).maxCoeff(&best);  // q* = argmax_q Q(s, c)_q (first on ties)
     float accel = accelFromNorm(act_c_(0, j));
+    if (defaults) {
+      const Decision& fallback = (*defaults)[static_cast<size_t>(j)];
+      const auto d = static_cast<nn::Index>(fallback.action);
+      if (act_q_(best, j) - act_q_(d, j) <= margin) {  // not worth departing from the default
+        best = d;
+        if (fallback.action == Action::kAccelerate) accel = fallback.accel_mps2;
+      }
+    }
     if (explore) {
       if (rng_->uniform01() < epsilon_) {
         best = static_cast<nn::Index>(rng_->uniformIndex(ACTION_COUNT));

@@ -46,6 +46,10 @@ void RsuControllerOptions::validate() const {
           "gradient_steps_per_decision", gradient_steps_per_decision, "must be finite and >= 0");
   require(advice_source == AdviceSource::kNetwork || !train, "train", "true",
           "is not possible with advice_source rules (a rule learns nothing)");
+  require(advice_source == AdviceSource::kNetwork || !rule_residual, "rule_residual", "true",
+          "needs advice_source network (the rule alone departs from nothing)");
+  require(std::isfinite(residual_margin) && residual_margin >= 0.0, "residual_margin", residual_margin,
+          "must be finite and >= 0");
   nested("rules", [&] { rules.validate(); });
   nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
@@ -237,11 +241,18 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
-  if (options_.advice_source == AdviceSource::kRules) {
+  const bool rule_first = options_.advice_source == AdviceSource::kRules || options_.rule_residual;
+  if (rule_first) {
     decisions.reserve(obs.member_vehicles.size());
     for (const VehicleSnapshot* v : obs.member_vehicles)
       decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
-  } else if (!obs.member_ids.empty()) {
+  }
+  if (options_.rule_residual && !obs.member_ids.empty()) {
+    std::vector<Decision> rule;
+    rule.swap(decisions);
+    agent_.actOverDefaults(obs.member_states, options_.train, rule, static_cast<float>(options_.residual_margin),
+                           decisions);
+  } else if (!rule_first && !obs.member_ids.empty()) {
     agent_.act(obs.member_states, options_.train, decisions);
   }
   for (size_t i = 0; i < decisions.size(); ++i)

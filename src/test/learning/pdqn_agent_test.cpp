@@ -3,6 +3,8 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -127,6 +129,47 @@ TEST(PdqnAgent, GreedyActionIsTheArgmaxOfQ) {
     EXPECT_EQ(static_cast<Index>(decisions[j].action), best);
     EXPECT_FLOAT_EQ(decisions[j].accel_mps2, accel(0, j));
   }
+}
+
+TEST(PdqnAgent, OverDefaultsTheGreedyActionDepartsOnlyByMoreThanTheMargin) {
+  PdqnAgent agent(smallConfig());
+  Rng data(3);
+  const Matrix states = randomStates(5, 40, data);
+  Matrix q, accel;
+  agent.evaluate(states, q, accel);
+  std::vector<Decision> defaults;
+  for (Index j = 0; j < 40; ++j) defaults.push_back(Decision{static_cast<Action>(j % ACTION_COUNT), 1.25f});
+  // A margin between the smallest and the largest gap, so both outcomes occur.
+  std::vector<float> gaps;
+  for (Index j = 0; j < 40; ++j) gaps.push_back(q.col(j).maxCoeff() - q(static_cast<Index>(defaults[j].action), j));
+  std::vector<float> sorted = gaps;
+  std::sort(sorted.begin(), sorted.end());
+  const float margin = 0.5f * (sorted[20] + sorted[21]);
+  ASSERT_LT(sorted[0], margin);
+  ASSERT_GT(sorted[39], margin);
+  std::vector<Decision> out;
+  agent.actOverDefaults(states, false, defaults, margin, out);
+  const std::vector<Decision> greedy = agent.act(states, false);
+  int departed = 0;
+  for (size_t j = 0; j < 40; ++j) {
+    const bool depart = gaps[j] > margin;
+    departed += depart;
+    const Decision& want = depart ? greedy[j] : defaults[j];
+    EXPECT_EQ(out[j].action, want.action) << "column " << j;
+    const float want_accel = (!depart && want.action == Action::kAccelerate) ? 1.25f : accel(0, static_cast<Index>(j));
+    EXPECT_FLOAT_EQ(out[j].accel_mps2, want_accel) << "column " << j;
+  }
+  EXPECT_GT(departed, 0);  // both outcomes seen
+  EXPECT_LT(departed, 40);
+  // Margin 0: the greedy action wherever it is strictly better; a huge one: the defaults.
+  agent.actOverDefaults(states, false, defaults, 1e9f, out);
+  for (size_t j = 0; j < 40; ++j) EXPECT_EQ(out[j].action, defaults[j].action);
+  agent.actOverDefaults(states, false, defaults, 0.0f, out);
+  for (size_t j = 0; j < 40; ++j) EXPECT_EQ(out[j].action, gaps[j] > 0 ? greedy[j].action : defaults[j].action);
+  EXPECT_THROW(agent.actOverDefaults(states, false, defaults, -1.0f, out), std::invalid_argument);
+  EXPECT_THROW(agent.actOverDefaults(states, false, defaults, std::nanf(""), out), std::invalid_argument);
+  defaults.pop_back();
+  EXPECT_THROW(agent.actOverDefaults(states, false, defaults, 0.0f, out), std::invalid_argument);
 }
 
 TEST(PdqnAgent, QIsTheQNetworkOnStateAndNormalisedParameter) {

@@ -56,6 +56,14 @@ class PdqnAgent {
   /// row count, zero columns or a non-finite value (agent unchanged).
   void act(const nn::Matrix& states, bool explore, std::vector<Decision>& out);
   std::vector<Decision> act(const nn::Matrix& states, bool explore);
+  /// act() over a default decision per column (a rule's advice): the greedy action is taken
+  /// only where its Q value exceeds the default action's by more than `margin` (>= 0, Q
+  /// units); elsewhere the default's action is, with the network's acceleration parameter
+  /// (the default's own for ACCELERATE). Exploration as act(): an exploring draw stays
+  /// random. Throws std::invalid_argument (agent unchanged) as act() does, on a defaults
+  /// count other than the column count, or a margin that is negative or not finite.
+  void actOverDefaults(const nn::Matrix& states, bool explore, const std::vector<Decision>& defaults,
+                       float margin, std::vector<Decision>& out);
 
   /// Stores a transition (accel_mps2 is clipped to the bounds). next_valid_actions: the
   /// actions that may be taken in next_state (ALL_ACTIONS when nothing is ruled out); the
@@ -123,6 +131,9 @@ class PdqnAgent {
  private:
   void checkStates(const nn::Matrix& states, const char* who) const;
   void forwardGreedy(const nn::Matrix& states);  // folded eval mode; fills act_c_, act_q_
+  // act() and actOverDefaults(): defaults null = plain greedy.
+  void decide(const nn::Matrix& states, bool explore, const std::vector<Decision>* defaults, float margin,
+              std::vector<Decision>& out);
   void buildQInput(const nn::Matrix& states, const nn::Matrix& c_norm, nn::Matrix& out) const;
   void selectQ(const nn::Matrix& q_out, nn::Index n, nn::Matrix& out) const;
   // td_target_valid_actions: -inf for the actions outside each column's mask.

@@ -45,7 +45,12 @@ struct RsuControllerOptions {
   /// kRules: the advice comes from ruleDecision() with `rules` (train must be false; the
   /// network is built but never asked).
   AdviceSource advice_source = AdviceSource::kNetwork;
-  RuleAdvisorOptions rules;  ///< the rule's thresholds (used with kRules)
+  RuleAdvisorOptions rules;  ///< the rule's thresholds (used with kRules and rule_residual)
+  /// kNetwork on top of the rule: the network's greedy advice replaces the rule's only where
+  /// its Q value exceeds that of the rule's action by more than residual_margin (>= 0, Q
+  /// units), so the policy starts from the rule and learns where to depart from it.
+  bool rule_residual = false;
+  double residual_margin = 0.0;
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;
