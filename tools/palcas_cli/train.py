@@ -70,7 +70,8 @@ VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "-
           "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
           "--v2x": "v2x_params", "--simulations": "simulations"}
 FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True),
-         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True)}
+         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True),
+         "--plan": ("plan", True)}
 # A new training's defaults as typed (DEFAULTS's values, 3600.0 as 3600).
 TYPED_DEFAULTS = {k: v if isinstance(v, str) else "%g" % v for k, v in DEFAULTS.items()
                   if k in ("episodes", "duration", "pr", "seed", "explore_fraction", "arm", "scenario")}
@@ -111,6 +112,9 @@ HELPS = {
                              "off: one RSU node per zone")),
     "--record-decisions": (None, D("record trajectories.csv and decisions.csv of every episode (every 10 steps), "
                                    "as ./palcas run does", "off")),
+    "--plan": (None, D("with --simulations K: write the training record and <out>/slurm_train.sh (one Slurm job: "
+                       "the server on the batch host, the K simulations as its tasks on any hosts, over one ROS "
+                       "master) and run nothing", "off")),
     "--resume": (None, D("continue the training in --out from its checkpoints; road, arm, PR, seed, duration "
                          "and overrides come from its train.json (a contradicting option is refused)", "off")),
 }
@@ -473,6 +477,77 @@ def run_simulations(out, opts, record, resume, command_line):
     return 0
 
 
+SLURM_SCRIPT = "slurm_train.sh"
+
+
+def write_slurm_script(out, opts, record, command_line):
+    """<out>/slurm_train.sh: the training of K simulations as one Slurm job. The batch
+    script's host runs the ROS master and the federation server (federation.launch); `srun`
+    starts the K simulations as the job's tasks (simulation.launch, task k = simulation k),
+    on whichever hosts Slurm gives, against that master: ROS_MASTER_URI names the batch
+    host, ROS_IP each host's own address (ROS 1 connects nodes peer to peer, so every host
+    must reach every other). Every host needs this repository built at the same path and
+    <out> on a shared file system. When the tasks end the server is stopped (SIGINT: it
+    checkpoints) and <out>/episodes.csv is merged, as ./palcas train does."""
+    import shlex
+    count, seed = simulation_count(opts), int(opts["seed"])
+    clusters = scenario_clusters(opts["scenario"])
+    auth_key = launch.message_key(out)
+    root = str(options.ROOT)
+    q = shlex.quote
+    server = " ".join(q(a) for a in federation_launch_args(opts, out, clusters, auth_key))
+    cases = []
+    for k in range(count):
+        args = system_launch_args(opts, record, command_line, episode_draw(opts, 0), simulation_seed(seed, k), clusters,
+                                  int(opts["episodes"]), 0, "true", out, simulation_dir(out, k), auth_key)
+        cases.append("    %d) mkdir -p %s; exec roslaunch --wait palcas_launch simulation.launch simulation:=%d %s \\\n"
+                     "         >>%s 2>&1 ;;\n"
+                     % (k, q(simulation_dir(out, k)), k, " ".join(q(a) for a in args),
+                        q(os.path.join(simulation_dir(out, k), "console.log"))))
+    text = (
+        "#!/bin/bash\n"
+        "# ./palcas train with %d simulations as one Slurm job (written by ./palcas train --plan):\n"
+        "#   sbatch %s\n"
+        "# The batch host runs the ROS master and the federation server; the %d tasks are the\n"
+        "# simulations (task k = simulation k, traffic seed %d + %d k), on any hosts, each with its\n"
+        "# RSUs in its bridge, all submitting to that one server. Every host needs this repository\n"
+        "# built at %s, ROS and SUMO installed, this folder on a shared file system, and\n"
+        "# network reach to every other host (ROS 1 links nodes peer to peer).\n"
+        "# Afterwards: ./palcas run --policy %s; an interrupted job continues on one machine\n"
+        "# with ./palcas train --resume --out %s.\n"
+        "#SBATCH --job-name=palcas-train\n#SBATCH --ntasks=%d\n#SBATCH --cpus-per-task=2\n"
+        "#SBATCH --time=72:00:00\n#SBATCH --output=%s/slurm-%%j.log\n"
+        "set -uo pipefail\n"
+        "source %s/devel/setup.bash\n"
+        "export SUMO_HOME=\"${SUMO_HOME:-/usr/share/sumo}\" ROS_LOG_DIR=%s\n"
+        "unset ROS_HOSTNAME  # ROS_IP below names each host\n"
+        "# A master port of this job's own: several jobs may share a host.\n"
+        "port=$((20000 + ${SLURM_JOB_ID:-0} %% 20000))\n"
+        "master_ip=$(hostname -I | awk '{print $1}')\n"
+        "export ROS_MASTER_URI=\"http://$master_ip:$port\" ROS_IP=\"$master_ip\"\n"
+        "roslaunch -p \"$port\" %s >>%s 2>&1 &\n"
+        "server=$!\n"
+        "# Each task: its host's own address, then its simulation.\n"
+        "srun --kill-on-bad-exit=1 bash -c '\n"
+        "  export ROS_IP=$(hostname -I | awk \"{print \\$1}\")\n"
+        "  case \"$SLURM_PROCID\" in\n"
+        "%s"
+        "  esac'\n"
+        "status=$?\n"
+        "kill -INT \"$server\"; wait \"$server\"\n"
+        "cd %s && /usr/bin/python3 -c 'import sys; sys.path[:0] = [\"tools\"]; from palcas_cli import train; "
+        "train.merge_simulation_episodes(sys.argv[1], int(sys.argv[2]))' %s %d\n"
+        "exit $status\n"
+        % (count, q(os.path.join(out, SLURM_SCRIPT)), count, seed, SIMULATION_SEED_STRIDE, root, out, out, count, out,
+           q(root), q(os.path.join(out, "ros_log")), server, q(os.path.join(out, "console.log")),
+           "".join(cases).replace("'", "'\\''"), q(root), q(out), count))
+    path = os.path.join(out, SLURM_SCRIPT)
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, 0o755)
+    return path
+
+
 def run_launches(out, opts, record, resume, command_line):
     """The launch loop: one roslaunch for the episodes left (one per episode when demand or
     PR is drawn per episode); a simulation that died ends that episode only (the nodes
@@ -586,6 +661,10 @@ def check(argv):
     opts["inprocess"] = bool(given.get("inprocess"))
     opts["record_decisions"] = bool(given.get("record_decisions"))
     opts["simulations"] = settle_simulations(given, record, out, opts)
+    opts["plan"] = bool(given.get("plan"))
+    if opts["plan"] and (opts["simulations"] == 1 or resume):
+        raise OptionError("--plan: writes the Slurm job of a new training of several simulations (give "
+                          "--simulations K with K > 1, without --resume)")
     return opts, record, out, resume
 
 
@@ -640,6 +719,10 @@ def main(argv):
         opts["learning"] = schedule
     command_line = "./palcas train " + " ".join(argv)
     record = write_record(out, opts, launch.git_commit(), command_line, resume)
+    if opts.get("plan"):
+        log("Slurm job of %d simulations: sbatch %s; then ./palcas run --policy %s"
+            % (simulation_count(opts), write_slurm_script(out, opts, record, command_line), out))
+        return 0
     try:
         run = run_simulations if simulation_count(opts) > 1 else run_launches
         status = run(out, opts, record, resume, command_line)
