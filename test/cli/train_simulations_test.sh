@@ -7,7 +7,7 @@
 #      seed and seed + 1000, the merged episodes.csv with its simulation column, and rounds
 #      that closed with submissions from both simulations' RSUs (the server's log).
 # Asserts on what the nodes logged and wrote, not on timing. Needs a built workspace; about
-# two minutes.
+# a minute.
 #
 #   test/cli/train_simulations_test.sh [--xml FILE]
 set -uo pipefail

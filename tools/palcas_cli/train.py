@@ -24,9 +24,10 @@ sim<k> with its own clock, its RSUs inside its bridge (ids rsu_<z> in simulation
 rsu_<z>_s<k> in the others) and its own traffic: simulation k's episode e runs seed
 + 1000 k + e (SIMULATION_SEED_STRIDE). --episodes counts per simulation. Each simulation
 writes into <out>/sim<k>/ (episodes.csv, metrics, console.log); <out>/episodes.csv is their
-union with a leading `simulation` column, rewritten after every launch; the checkpoints
-(the server's global model: the shipped policy) are shared in <out>/checkpoints/. A
-simulation that ends short or loses a node stops the others and fails the command (exit 1);
+union with a leading `simulation` column, rewritten when the simulations end; the
+checkpoints (the server's global model: the shipped policy) are shared in <out>/checkpoints/.
+A simulation whose SUMO crashed loses that episode and goes on with its next one (as one
+simulation does); a node lost for good stops the others and fails the command (exit 1);
 --resume continues each simulation from its own episodes.csv.
 
 Exit status: 0 done; 1 a node died for good or nothing was trained; 2 a bad option;
@@ -387,88 +388,104 @@ def federation_launch_args(opts, out, clusters, auth_key):
 
 def run_simulations(out, opts, record, resume, command_line):
     """K simulations training one federation (--simulations K > 1): the server's launch
-    (it starts the ROS master), then one launch per simulation that still has episodes to
-    run, against that master. Waits for every simulation; one that ends short or loses a
-    node stops the others: exit 1, naming it. The server stops last. Returns the exit status;
-    raises launch.Interrupted (every node stopped and checkpointed)."""
+    (it starts the ROS master), then one launch per simulation with episodes left, against
+    that master. A simulation whose SUMO crashed loses that episode only and goes on with its
+    next one in a new launch (as a single simulation does), the others running on; an RSU
+    or server lost for good, a simulation out of relaunches or a server launch that ended
+    stops every simulation and fails (exit 1, naming it). The server stops last. Returns the
+    exit status; raises launch.Interrupted (every node stopped and checkpointed)."""
     count, episodes, seed = simulation_count(opts), int(opts["episodes"]), int(opts["seed"])
     clusters = scenario_clusters(opts["scenario"])
     auth_key = launch.message_key(out)
-    done = [episodes_done(simulation_dir(out, k)) for k in range(count)]
+    nxt = [episodes_done(simulation_dir(out, k)) for k in range(count)]
     log("training %s: %d simulations (seeds %s), episodes %s..%d each x %ss, pr=%s%% demand=%s -> %s"
         % (opts["arm"], count, ", ".join(str(simulation_seed(seed, k)) for k in range(count)),
-           "/".join(str(d + 1) for d in done), episodes, number_text(opts["duration"]), value_text(opts["pr"]),
+           "/".join(str(d + 1) for d in nxt), episodes, number_text(opts["duration"]), value_text(opts["pr"]),
            value_text(opts["demand"]) + (" veh/h/lane" if opts["demand"] is not None else ""), out))
     log_dir = os.path.join(out, "ros_log")
     server = launch.Launch(federation_launch_args(opts, out, clusters, auth_key), os.path.join(out, "console.log"),
                            log_dir, append=True).start()
-    sims, monitor, failures = {}, None, []
+    sims, rows_before, asked, launches, monitor, lost = {}, {}, {}, [0] * count, None, []
+    budget = episodes + 3 + episodes // 4  # launches per simulation, as a single one has
+
+    def start(k):
+        os.makedirs(simulation_dir(out, k), exist_ok=True)
+        rows_before[k], asked[k] = episodes_done(simulation_dir(out, k)), episodes - nxt[k]
+        launches[k] += 1
+        args = system_launch_args(opts, record, command_line, episode_draw(opts, nxt[k]), simulation_seed(seed, k),
+                                  clusters, episodes - nxt[k], nxt[k], "true", out, simulation_dir(out, k), auth_key)
+        sims[k] = launch.Launch(["palcas_launch", "simulation.launch", "simulation:=%d" % k] + args,
+                                os.path.join(simulation_dir(out, k), "console.log"), log_dir, append=True,
+                                master_port=server.port).start()
+
+    def ended(k):
+        """Simulation k's launch ended: go on with its next episode, or say why it cannot."""
+        sims.pop(k).wait()  # at once; raises Interrupted if the command was stopped
+        console_log = os.path.join(simulation_dir(out, k), "console.log")
+        text = launch.read_text(console_log)
+        bridge = "sim%d/palcas_sumo_bridge" % k
+        deaths = [d for d in launch.node_deaths(text) if not d.startswith(bridge)]
+        if deaths:
+            lost.append("simulation %d lost %s; last error: %s" % (k, ", ".join(deaths), launch.last_fatal(text)))
+            return
+        finished = episodes_done(simulation_dir(out, k)) - rows_before[k]
+        nxt[k] += finished
+        if finished < asked[k]:
+            # Its SUMO crashed (or its bridge failed): that episode only is lost.
+            why = launch.crash_reason(text) or "ended early, no reason in the log"
+            log("simulation %d: episode %d ended early (%s); it goes on with its next episode" % (k, nxt[k] + 1, why))
+            with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
+                f.write("simulation %d episode %d (seed %d): %s\n"
+                        % (k, nxt[k], simulation_seed(seed, k) + nxt[k], why))
+            os.replace(console_log, os.path.join(simulation_dir(out, k), "console-aborted-%d.log" % nxt[k]))
+            nxt[k] += 1
+        if nxt[k] < episodes:
+            if launches[k] >= budget:
+                lost.append("simulation %d: %d launches and still %d episodes to go" % (k, launches[k], episodes - nxt[k]))
+            else:
+                start(k)
+
     try:
         for k in range(count):
-            if done[k] >= episodes:
-                continue
-            os.makedirs(simulation_dir(out, k), exist_ok=True)
-            draw = episode_draw(opts, done[k])
-            args = system_launch_args(opts, record, command_line, draw, simulation_seed(seed, k), clusters,
-                                      episodes - done[k], done[k], "true", out, simulation_dir(out, k), auth_key)
-            sims[k] = launch.Launch(["palcas_launch", "simulation.launch", "simulation:=%d" % k] + args,
-                                    os.path.join(simulation_dir(out, k), "console.log"), log_dir, append=True,
-                                    master_port=server.port).start()
-        # The progress line follows the first simulation still running (the others run the
-        # same episodes on other traffic); its topics are in its namespace.
+            if nxt[k] < episodes:
+                start(k)
+        # The progress line follows the first simulation (the others run the same episodes on
+        # other traffic); its topics are in its namespace.
         watched = min(sims) if sims else 0
         ns = "/sim%d" % watched
         rsus = simulation_rsu_ids(opts["arm"], clusters, watched)
-        monitor = subprocess.Popen(
+        monitor = None if not sims else subprocess.Popen(
             ["setpriv", "--pdeathsig", "TERM", sys.executable,
              os.path.join(str(options.ROOT), "tools", "train_monitor.py"), "--rsus"] + rsus
-            + ["--episodes", str(episodes - done[watched]), "--first-episode", str(done[watched]),
+            + ["--episodes", str(episodes - nxt[watched]), "--first-episode", str(nxt[watched]),
                "--total-episodes", str(episodes), "--duration", number_text(opts["duration"]), "--period", "15",
                "--episodes-csv", os.path.join(simulation_dir(out, watched), "episodes.csv"),
                "/episode_metrics:=%s/episode_metrics" % ns]
             + ["/%s/rsu_status:=%s/%s/rsu_status" % (rsu, ns, rsu) for rsu in rsus],
             stderr=subprocess.DEVNULL, env=launch.ros_env(server.port, log_dir))
-
-        def short(k):
-            return episodes_done(simulation_dir(out, k)) < episodes
-
-        def stop_the_others_if_one_failed():
-            for k, sim in sims.items():
-                if not failures and not sim.running() and short(k):
-                    failures.append(k)
-                    for other in sims.values():
-                        other.interrupt()
-            if not server.running() and not failures:
-                failures.append("server")
-                for other in sims.values():
-                    other.interrupt()
-
-        for k in sorted(sims):
-            sims[k].wait(tick=stop_the_others_if_one_failed)
-        stop_the_others_if_one_failed()
+        while sims and not lost:
+            if launch.interrupted():
+                raise launch.Interrupted(launch.interrupted())
+            for k in [k for k, sim in sims.items() if not sim.running()]:
+                ended(k)
+            if not server.running():
+                lost.append("the federation server's launch ended before the simulations")
+            time.sleep(launch.POLL_S)
     finally:
         if monitor:
             monitor.terminate()
             monitor.wait()
-        # An interrupted command: every simulation checkpoints before the master goes.
+        # Stopped or failed: every simulation checkpoints and ends before the master goes.
+        for sim in sims.values():
+            sim.interrupt()
         deadline = time.time() + 120
         for sim in sims.values():
             sim.kill_after(deadline)
         server.interrupt()
         server.kill_after(time.time() + 60)
         merge_simulation_episodes(out, count)
-    lost = []
-    for k in sorted(sims):
-        text = launch.read_text(os.path.join(simulation_dir(out, k), "console.log"))
-        lost += ["simulation %d: %s" % (k, d) for d in launch.node_deaths(text)]
-        if short(k):
-            why = launch.crash_reason(text) if k in failures else "stopped when another simulation failed"
-            lost.append("simulation %d ended after %d of %d episodes (%s)"
-                        % (k, episodes_done(simulation_dir(out, k)), episodes, why or "no reason in the log"))
     server_text = launch.read_text(os.path.join(out, "console.log"))
-    lost += ["federation server: %s" % d for d in launch.node_deaths(server_text)]
-    if "server" in failures:
-        lost.append("the federation server's launch ended before the simulations")
+    lost += ["federation server lost: %s" % d for d in launch.node_deaths(server_text)]
     if lost:
         console.error("training of %d simulations failed: %s" % (count, "; ".join(lost)))
         with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
