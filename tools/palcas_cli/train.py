@@ -37,6 +37,7 @@ import json
 import os
 import random
 import re
+import socket
 import subprocess
 import sys
 import time
@@ -386,6 +387,17 @@ def federation_launch_args(opts, out, clusters, auth_key):
             "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=true", "auth_key_file:=%s" % auth_key]
 
 
+def master_up(port, wait_s=30.0):
+    """Waits (at most wait_s) until the ROS master on this host's PORT takes connections."""
+    end = time.time() + wait_s
+    while time.time() < end and not launch.interrupted():
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+            return
+        except OSError:
+            time.sleep(launch.POLL_S)
+
+
 def run_simulations(out, opts, record, resume, command_line):
     """K simulations training one federation (--simulations K > 1): the server's launch
     (it starts the ROS master), then one launch per simulation with episodes left, against
@@ -451,6 +463,7 @@ def run_simulations(out, opts, record, resume, command_line):
                 start(k)
         # The progress line follows the first simulation (the others run the same episodes on
         # other traffic); its topics are in its namespace.
+        master_up(server.port)  # else the monitor's first line is rospy's complaint
         watched = min(sims) if sims else 0
         ns = "/sim%d" % watched
         rsus = simulation_rsu_ids(opts["arm"], clusters, watched)
