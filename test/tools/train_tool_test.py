@@ -291,6 +291,61 @@ class DemandAndRanges(unittest.TestCase):
         self.assertEqual(calls[0]["demand"], "scenario")
 
 
+class Simulations(unittest.TestCase):
+    """--simulations K: what the options, the record and the folders say (the launches
+    themselves: test/cli/train_simulations_test.sh)."""
+
+    def test_bad_counts_and_combinations_are_refused_naming_the_option(self):
+        for argv, text in ((["--simulations", "0"], "--simulations '0': expected an integer in \\[1, 64\\]"),
+                           (["--simulations", "-2"], "--simulations '-2'"),
+                           (["--simulations", "two"], "--simulations 'two'"),
+                           (["--simulations", "65"], "--simulations '65'"),
+                           (["--simulations", "2", "--arm", "independent"], "has no federation"),
+                           (["--simulations", "2", "--pr-range", "10,20"], "not with --demand-range or --pr-range"),
+                           (["--simulations", "2", "--episodes", "1001"], "at most 1000 --episodes"),
+                           (["--plan"], "--plan")):
+            with self.subTest(argv=argv), self.assertRaisesRegex(OptionError, text):
+                train.check(argv)
+
+    def test_one_simulation_is_todays_training(self):
+        opts = train.check([])[0]
+        self.assertEqual((opts["simulations"], opts["inprocess"]), (1, False))
+        out = tempfile.mkdtemp()
+        record = train.write_record(out, dict(opts, learning="", rsu_params="", bridge_params=""), "abc")
+        self.assertNotIn("simulations", record)
+        opts = train.check(["--simulations", "3"])[0]
+        self.assertEqual((opts["simulations"], opts["inprocess"]), (3, True))
+
+    def test_resume_keeps_the_recorded_count_and_refuses_another(self):
+        out = tempfile.mkdtemp()
+        opts = dict(train.check(["--simulations", "2", "--scenario", "tiny"])[0], learning="", rsu_params="",
+                    bridge_params="")
+        train.write_record(out, opts, "abc")
+        self.assertEqual(train.check(["--resume", "--out", out])[0]["simulations"], 2)
+        with self.assertRaisesRegex(OptionError, "trained with --simulations 2, not --simulations 3"):
+            train.check(["--resume", "--out", out, "--simulations", "3"])
+
+    def test_ids_seeds_and_folders_differ_per_simulation(self):
+        self.assertEqual(train.simulation_rsu_ids("palcas", 2, 0), ["rsu_0", "rsu_1"])
+        self.assertEqual(train.simulation_rsu_ids("palcas", 2, 2), ["rsu_0_s2", "rsu_1_s2"])
+        self.assertEqual([train.simulation_seed(5, k) for k in range(3)], [5, 1005, 2005])
+        self.assertEqual(train.simulation_dir("/o", 1), "/o/sim1")
+        args = train.federation_launch_args(dict(train.DEFAULTS, simulations=2), "/o", 2, "/o/auth.key")
+        self.assertIn("expected_rsus:=[rsu_0, rsu_1, rsu_0_s1, rsu_1_s1]", args)
+
+    def test_episodes_csv_merges_every_simulation_with_its_column(self):
+        out = tempfile.mkdtemp()
+        for k, rows in ((0, ["0,1,600", "1,2,600"]), (1, ["0,1001,600"])):
+            os.makedirs(train.simulation_dir(out, k))
+            with open(os.path.join(train.simulation_dir(out, k), "episodes.csv"), "w") as f:
+                f.write("episode,seed,sim_seconds\n" + "".join(r + "\n" for r in rows))
+        train.merge_simulation_episodes(out, 2)
+        with open(os.path.join(out, "episodes.csv")) as f:
+            self.assertEqual(f.read(), "simulation,episode,seed,sim_seconds\n0,0,1,600\n1,0,1001,600\n0,1,2,600\n")
+        self.assertEqual(train.training_episodes_done(out, {"simulations": 2}), 1)
+        self.assertEqual(train.training_episodes_done(out, {"simulations": 1}), 3)
+
+
 class Roads(unittest.TestCase):
     def test_clusters_come_from_the_roads_description(self):
         self.assertEqual(train.scenario_clusters("paper"), 3)

@@ -163,17 +163,21 @@ class Launch:
     every node (test/faults/train_sigkill_test.sh). Success is judged by what the run writes,
     not by roslaunch's status."""
 
-    def __init__(self, args, console, log_dir, append=False, show=None, shown=None):
+    def __init__(self, args, console, log_dir, append=False, show=None, shown=None, master_port=None):
         self.args, self.console, self.log_dir = list(args), str(console), str(log_dir)
         self.append, self.show = append, re.compile(show) if show else None
         self.shown = shown or sys.stdout
+        # master_port: join the master another launch of this command started there (it waits
+        # for it) instead of starting one of its own on a free port.
+        self.master_port = master_port
         self.port, self.process, self._offset, self._partial = None, None, 0, ""
         self._start_offset = 0
 
     def start(self):
         if interrupted():  # the command was stopped before this launch: none starts
             raise Interrupted(interrupted())
-        self.port = free_port()
+        self.port = self.master_port or free_port()
+        master = ["--wait"] if self.master_port else ["-p", str(self.port)]
         mode = "a" if self.append else "w"
         with open(self.console, mode) as console:
             self._offset = self._start_offset = console.tell()
@@ -181,7 +185,7 @@ class Launch:
                 # env --default-signal: a command started in the background by a non-interactive
                 # shell (a CI runner, `./palcas test &`) passes SIGINT on ignored, and a launch
                 # that starts with it ignored may never see the stop it carries.
-                ["env", "--default-signal=INT", "setpriv", "--pdeathsig", "INT", "roslaunch", "-p", str(self.port)]
+                ["env", "--default-signal=INT", "setpriv", "--pdeathsig", "INT", "roslaunch"] + master
                 + self.args,
                 stdout=console, stderr=subprocess.STDOUT, env=ros_env(self.port, self.log_dir),
                 start_new_session=True)

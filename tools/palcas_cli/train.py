@@ -17,6 +17,19 @@ costs a few seconds of start-up per episode and changes nothing else. Without a 
 episodes share one launch, as before. The ranges and every episode's draw are in train.json
 (episode_draws), and the bridge writes each episode's demand and PR into episodes.csv.
 
+Several simulations (--simulations K, K > 1) train one federation at once: one federation
+server (launch/federation.launch, rounds on wall time) and K simulations (launch/
+simulation.launch), each its own roslaunch against the server's ROS master, in the namespace
+sim<k> with its own clock, its RSUs inside its bridge (ids rsu_<z> in simulation 0,
+rsu_<z>_s<k> in the others) and its own traffic: simulation k's episode e runs seed
++ 1000 k + e (SIMULATION_SEED_STRIDE). --episodes counts per simulation. Each simulation
+writes into <out>/sim<k>/ (episodes.csv, metrics, console.log); <out>/episodes.csv is their
+union with a leading `simulation` column, rewritten when the simulations end; the
+checkpoints (the server's global model: the shipped policy) are shared in <out>/checkpoints/.
+A simulation whose SUMO crashed loses that episode and goes on with its next one (as one
+simulation does); a node lost for good stops the others and fails the command (exit 1);
+--resume continues each simulation from its own episodes.csv.
+
 Exit status: 0 done; 1 a node died for good or nothing was trained; 2 a bad option;
 130 / 143 interrupted (SIGINT / SIGTERM: every process stopped and checkpointed)."""
 import datetime
@@ -24,8 +37,10 @@ import json
 import os
 import random
 import re
+import socket
 import subprocess
 import sys
+import time
 
 from palcas_cli import Console, launch, options
 from palcas_cli.options import OptionError
@@ -44,15 +59,21 @@ RESUMED_DEMAND = {"demand": "demand_vphpl", "ramp_demand": "ramp_demand_vph",
                   "demand_range": "demand_range", "pr_range": "pr_range"}
 ALL_GIVEN = ("arm", "episodes", "duration", "pr", "seed", "scenario", "explore_fraction", "demand",
              "ramp_demand", "demand_range", "pr_range")
+# --simulations: at most this many at once (each is a SUMO, a bridge and its RSUs).
+MAX_SIMULATIONS = 64
+# Simulation k's traffic seed is seed + k * this (episode e: + e), so its episodes never
+# repeat another simulation's traffic while a simulation runs fewer episodes than this.
+SIMULATION_SEED_STRIDE = 1000
 
 
 VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "--duration": "duration",
           "--pr": "pr", "--pr-range": "pr_range", "--demand": "demand", "--demand-range": "demand_range",
           "--ramp-demand": "ramp_demand", "--seed": "seed", "--arm": "arm", "--out": "out", "--scenario": "scenario",
           "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
-          "--v2x": "v2x_params"}
+          "--v2x": "v2x_params", "--simulations": "simulations"}
 FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True),
-         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True)}
+         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True),
+         "--plan": ("plan", True)}
 # A new training's defaults as typed (DEFAULTS's values, 3600.0 as 3600).
 TYPED_DEFAULTS = {k: v if isinstance(v, str) else "%g" % v for k, v in DEFAULTS.items()
                   if k in ("episodes", "duration", "pr", "seed", "explore_fraction", "arm", "scenario")}
@@ -83,11 +104,19 @@ HELPS = {
     "--bridge-params": ("FILE", D("a bridge parameter override (e.g. config/training/unclipped_advisories.yaml)",
                                   "none")),
     "--v2x": ("FILE", D("train with the V2X channel on (as for run)", "off")),
+    "--simulations": ("K", D("simulations training one federation at once, at most %d: each with its own SUMO, "
+                             "bridge, RSUs (in-process) and traffic (simulation k: seed + %d k), all submitting "
+                             "to one federation server; --episodes counts per simulation; <out>/sim<k>/ holds "
+                             "each one's episodes (--resume: the training's own)" % (MAX_SIMULATIONS, SIMULATION_SEED_STRIDE),
+                             "1")),
     "--in-process": (None, D("run the RSUs inside the bridge process (the RSU node's own decision code, a call "
                              "per step instead of ROS topics; federation still over the server's services)",
                              "off: one RSU node per zone")),
     "--record-decisions": (None, D("record trajectories.csv and decisions.csv of every episode (every 10 steps), "
                                    "as ./palcas run does", "off")),
+    "--plan": (None, D("with --simulations K: write the training record and <out>/slurm_train.sh (one Slurm job: "
+                       "the server on the batch host, the K simulations as its tasks on any hosts, over one ROS "
+                       "master) and run nothing", "off")),
     "--resume": (None, D("continue the training in --out from its checkpoints; road, arm, PR, seed, duration "
                          "and overrides come from its train.json (a contradicting option is refused)", "off")),
 }
@@ -233,12 +262,65 @@ def write_record(out, opts, git_commit, command_line="", resume=False):
               "resumed_with": earlier.get("resumed_with", []) + ([command_line] if resume else [])}
     if sampled(opts):
         record["episode_draws"] = [episode_draw(opts, k) for k in range(int(opts["episodes"]))]
+    if simulation_count(opts) > 1:  # a one-simulation record stays as it always was
+        record["simulations"] = simulation_count(opts)
+        record["simulation_seed_stride"] = SIMULATION_SEED_STRIDE
     tmp = os.path.join(out, ".train.json.tmp")
     with open(tmp, "w") as f:
         json.dump(record, f)
         f.write("\n")
     os.replace(tmp, str(policy_folder.train_record_path(out)))
     return record
+
+
+def simulation_count(opts):
+    return int(opts.get("simulations") or 1)
+
+
+def simulation_dir(out, k):
+    """Simulation k's own folder (--simulations K > 1): its bridge's out_dir."""
+    return os.path.join(out, "sim%d" % k)
+
+
+def simulation_seed(seed, k):
+    """Simulation k's traffic seed (its episode e runs this + e)."""
+    return int(seed) + SIMULATION_SEED_STRIDE * k
+
+
+def simulation_rsu_ids(arm, clusters, k):
+    """Simulation k's RSU ids, unique across the federation (launch/simulation.launch names
+    them so): rsu_<z> in simulation 0, rsu_<z>_s<k> in the others."""
+    return [rsu if k == 0 else "%s_s%d" % (rsu, k) for rsu in palcas_arms.rsu_ids(arm, clusters)]
+
+
+def training_episodes_done(out, opts):
+    """Episodes every simulation has finished (one simulation: rows of <out>/episodes.csv)."""
+    if simulation_count(opts) == 1:
+        return episodes_done(out)
+    return min(episodes_done(simulation_dir(out, k)) for k in range(simulation_count(opts)))
+
+
+def merge_simulation_episodes(out, count):
+    """<out>/episodes.csv of a training of several simulations: every simulation's rows
+    (<out>/sim<k>/episodes.csv) with a leading `simulation` column, by episode, then simulation."""
+    header, rows = None, []
+    for k in range(count):
+        try:
+            with open(os.path.join(simulation_dir(out, k), "episodes.csv")) as f:
+                lines = f.read().splitlines()
+        except OSError:
+            continue
+        if not lines:
+            continue
+        header = header or lines[0]
+        rows += [(int(line.split(",", 1)[0]), k, line) for line in lines[1:] if line.strip()]
+    if header is None:
+        return
+    tmp = os.path.join(out, ".episodes.csv.tmp")
+    with open(tmp, "w") as f:
+        f.write("simulation," + header + "\n")
+        f.writelines("%d,%s\n" % (k, line) for _, k, line in sorted(rows))
+    os.replace(tmp, os.path.join(out, "episodes.csv"))
 
 
 def episodes_done(out):
@@ -276,6 +358,226 @@ def keep_episode_metrics(out, episode):
         f.write(text)
 
 
+def system_launch_args(opts, record, command_line, draw, seed, clusters, count, first, resume_nodes, out, run_dir,
+                       auth_key):
+    """system.launch's arguments for `count` training episodes from `first` of traffic `seed`
+    (and the episode's draw), the bridge writing into run_dir, the checkpoints in out's."""
+    return [
+        "arm:=%s" % opts["arm"], "mode:=train", "pr:=%s" % number_text(draw["pr"]), "seed:=%d" % seed,
+        "demand:=%s" % ("scenario" if draw["demand_vphpl"] is None else number_text(draw["demand_vphpl"])),
+        "ramp_demand:=%s" % ("scenario" if opts.get("ramp_demand") is None else number_text(opts["ramp_demand"])),
+        "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % count,
+        "first_episode:=%d" % first, "duration:=%s" % number_text(opts["duration"]),
+        "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=%s" % resume_nodes,
+        "out_dir:=%s" % run_dir, "learning_params:=%s" % (opts.get("learning") or "none"),
+        "rsu_params:=%s" % (opts.get("rsu_params") or "none"),
+        "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
+        "v2x_params:=%s" % (opts.get("v2x_params") or "none"),
+        "paper_printed:=%s" % str(bool(opts.get("paper_printed"))).lower(), "auth_key_file:=%s" % auth_key,
+        "inprocess:=%s" % str(bool(opts.get("inprocess"))).lower(),
+        "trajectory_period_steps:=%d" % (10 if opts.get("record_decisions") else 0),
+        "git_commit:=%s" % record["git_commit"], "command_line:=%s" % command_line]
+
+
+def federation_launch_args(opts, out, clusters, auth_key):
+    """federation.launch's arguments: one server for every simulation's RSUs."""
+    rsus = [rsu for k in range(simulation_count(opts)) for rsu in simulation_rsu_ids(opts["arm"], clusters, k)]
+    return ["palcas_launch", "federation.launch", "expected_rsus:=[%s]" % ", ".join(rsus),
+            "seed:=%d" % int(opts["seed"]), "learning_params:=%s" % (opts.get("learning") or "none"),
+            "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=true", "auth_key_file:=%s" % auth_key]
+
+
+def master_up(port, wait_s=30.0):
+    """Waits (at most wait_s) until the ROS master on this host's PORT takes connections."""
+    end = time.time() + wait_s
+    while time.time() < end and not launch.interrupted():
+        try:
+            socket.create_connection(("127.0.0.1", port), timeout=1).close()
+            return
+        except OSError:
+            time.sleep(launch.POLL_S)
+
+
+def run_simulations(out, opts, record, resume, command_line):
+    """K simulations training one federation (--simulations K > 1): the server's launch
+    (it starts the ROS master), then one launch per simulation with episodes left, against
+    that master. A simulation whose SUMO crashed loses that episode only and goes on with its
+    next one in a new launch (as a single simulation does), the others running on; an RSU
+    or server lost for good, a simulation out of relaunches or a server launch that ended
+    stops every simulation and fails (exit 1, naming it). The server stops last. Returns the
+    exit status; raises launch.Interrupted (every node stopped and checkpointed)."""
+    count, episodes, seed = simulation_count(opts), int(opts["episodes"]), int(opts["seed"])
+    clusters = scenario_clusters(opts["scenario"])
+    auth_key = launch.message_key(out)
+    nxt = [episodes_done(simulation_dir(out, k)) for k in range(count)]
+    log("training %s: %d simulations (seeds %s), episodes %s..%d each x %ss, pr=%s%% demand=%s -> %s"
+        % (opts["arm"], count, ", ".join(str(simulation_seed(seed, k)) for k in range(count)),
+           "/".join(str(d + 1) for d in nxt), episodes, number_text(opts["duration"]), value_text(opts["pr"]),
+           value_text(opts["demand"]) + (" veh/h/lane" if opts["demand"] is not None else ""), out))
+    log_dir = os.path.join(out, "ros_log")
+    server = launch.Launch(federation_launch_args(opts, out, clusters, auth_key), os.path.join(out, "console.log"),
+                           log_dir, append=True).start()
+    sims, rows_before, asked, launches, monitor, lost = {}, {}, {}, [0] * count, None, []
+    budget = episodes + 3 + episodes // 4  # launches per simulation, as a single one has
+
+    def start(k):
+        os.makedirs(simulation_dir(out, k), exist_ok=True)
+        rows_before[k], asked[k] = episodes_done(simulation_dir(out, k)), episodes - nxt[k]
+        launches[k] += 1
+        args = system_launch_args(opts, record, command_line, episode_draw(opts, nxt[k]), simulation_seed(seed, k),
+                                  clusters, episodes - nxt[k], nxt[k], "true", out, simulation_dir(out, k), auth_key)
+        sims[k] = launch.Launch(["palcas_launch", "simulation.launch", "simulation:=%d" % k] + args,
+                                os.path.join(simulation_dir(out, k), "console.log"), log_dir, append=True,
+                                master_port=server.port).start()
+
+    def ended(k):
+        """Simulation k's launch ended: go on with its next episode, or say why it cannot."""
+        sims.pop(k).wait()  # at once; raises Interrupted if the command was stopped
+        console_log = os.path.join(simulation_dir(out, k), "console.log")
+        text = launch.read_text(console_log)
+        bridge = "sim%d/palcas_sumo_bridge" % k
+        deaths = [d for d in launch.node_deaths(text) if not d.startswith(bridge)]
+        if deaths:
+            lost.append("simulation %d lost %s; last error: %s" % (k, ", ".join(deaths), launch.last_fatal(text)))
+            return
+        finished = episodes_done(simulation_dir(out, k)) - rows_before[k]
+        nxt[k] += finished
+        if finished < asked[k]:
+            # Its SUMO crashed (or its bridge failed): that episode only is lost.
+            why = launch.crash_reason(text) or "ended early, no reason in the log"
+            log("simulation %d: episode %d ended early (%s); it goes on with its next episode" % (k, nxt[k] + 1, why))
+            with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
+                f.write("simulation %d episode %d (seed %d): %s\n"
+                        % (k, nxt[k], simulation_seed(seed, k) + nxt[k], why))
+            os.replace(console_log, os.path.join(simulation_dir(out, k), "console-aborted-%d.log" % nxt[k]))
+            nxt[k] += 1
+        if nxt[k] < episodes:
+            if launches[k] >= budget:
+                lost.append("simulation %d: %d launches and still %d episodes to go" % (k, launches[k], episodes - nxt[k]))
+            else:
+                start(k)
+
+    try:
+        for k in range(count):
+            if nxt[k] < episodes:
+                start(k)
+        # The progress line follows the first simulation (the others run the same episodes on
+        # other traffic); its topics are in its namespace.
+        master_up(server.port)  # else the monitor's first line is rospy's complaint
+        watched = min(sims) if sims else 0
+        ns = "/sim%d" % watched
+        rsus = simulation_rsu_ids(opts["arm"], clusters, watched)
+        monitor = None if not sims else subprocess.Popen(
+            ["setpriv", "--pdeathsig", "TERM", sys.executable,
+             os.path.join(str(options.ROOT), "tools", "train_monitor.py"), "--rsus"] + rsus
+            + ["--episodes", str(episodes - nxt[watched]), "--first-episode", str(nxt[watched]),
+               "--total-episodes", str(episodes), "--duration", number_text(opts["duration"]), "--period", "15",
+               "--episodes-csv", os.path.join(simulation_dir(out, watched), "episodes.csv"),
+               "/episode_metrics:=%s/episode_metrics" % ns]
+            + ["/%s/rsu_status:=%s/%s/rsu_status" % (rsu, ns, rsu) for rsu in rsus],
+            stderr=subprocess.DEVNULL, env=launch.ros_env(server.port, log_dir))
+        while sims and not lost:
+            if launch.interrupted():
+                raise launch.Interrupted(launch.interrupted())
+            for k in [k for k, sim in sims.items() if not sim.running()]:
+                ended(k)
+            if not server.running():
+                lost.append("the federation server's launch ended before the simulations")
+            time.sleep(launch.POLL_S)
+    finally:
+        if monitor:
+            monitor.terminate()
+            monitor.wait()
+        # Stopped or failed: every simulation checkpoints and ends before the master goes.
+        for sim in sims.values():
+            sim.interrupt()
+        deadline = time.time() + 120
+        for sim in sims.values():
+            sim.kill_after(deadline)
+        server.interrupt()
+        server.kill_after(time.time() + 60)
+        merge_simulation_episodes(out, count)
+    server_text = launch.read_text(os.path.join(out, "console.log"))
+    lost += ["federation server lost: %s" % d for d in launch.node_deaths(server_text)]
+    if lost:
+        console.error("training of %d simulations failed: %s" % (count, "; ".join(lost)))
+        with open(os.path.join(out, "aborted_episodes.txt"), "a") as f:
+            f.write("".join(line + "\n" for line in lost))
+        return 1
+    return 0
+
+
+SLURM_SCRIPT = "slurm_train.sh"
+
+
+def write_slurm_script(out, opts, record, command_line):
+    """<out>/slurm_train.sh: the training of K simulations as one Slurm job. The batch
+    script's host runs the ROS master and the federation server (federation.launch); `srun`
+    starts the K simulations as the job's tasks (simulation.launch, task k = simulation k),
+    on whichever hosts Slurm gives, against that master: ROS_MASTER_URI names the batch
+    host, ROS_IP each host's own address (ROS 1 connects nodes peer to peer, so every host
+    must reach every other). Every host needs this repository built at the same path and
+    <out> on a shared file system. When the tasks end the server is stopped (SIGINT: it
+    checkpoints) and <out>/episodes.csv is merged, as ./palcas train does."""
+    import shlex
+    count, seed = simulation_count(opts), int(opts["seed"])
+    clusters = scenario_clusters(opts["scenario"])
+    auth_key = launch.message_key(out)
+    root = str(options.ROOT)
+    q = shlex.quote
+    server = " ".join(q(a) for a in federation_launch_args(opts, out, clusters, auth_key))
+    cases = []
+    for k in range(count):
+        args = system_launch_args(opts, record, command_line, episode_draw(opts, 0), simulation_seed(seed, k), clusters,
+                                  int(opts["episodes"]), 0, "true", out, simulation_dir(out, k), auth_key)
+        cases.append("    %d) mkdir -p %s; exec roslaunch --wait palcas_launch simulation.launch simulation:=%d %s \\\n"
+                     "         >>%s 2>&1 ;;\n"
+                     % (k, q(simulation_dir(out, k)), k, " ".join(q(a) for a in args),
+                        q(os.path.join(simulation_dir(out, k), "console.log"))))
+    text = (
+        "#!/bin/bash\n"
+        "# ./palcas train with %d simulations as one Slurm job (written by ./palcas train --plan):\n"
+        "#   sbatch %s\n"
+        "# The batch host runs the ROS master and the federation server; the %d tasks are the\n"
+        "# simulations (task k = simulation k, traffic seed %d + %d k), on any hosts, each with its\n"
+        "# RSUs in its bridge, all submitting to that one server. Every host needs this repository\n"
+        "# built at %s, ROS and SUMO installed, this folder on a shared file system, and\n"
+        "# network reach to every other host (ROS 1 links nodes peer to peer).\n"
+        "# Afterwards: ./palcas run --policy %s; an interrupted job continues on one machine\n"
+        "# with ./palcas train --resume --out %s.\n"
+        "#SBATCH --job-name=palcas-train\n#SBATCH --ntasks=%d\n#SBATCH --cpus-per-task=2\n"
+        "#SBATCH --time=72:00:00\n#SBATCH --output=%s/slurm-%%j.log\n"
+        "set -uo pipefail\n"
+        "source %s/devel/setup.bash\n"
+        "export SUMO_HOME=\"${SUMO_HOME:-/usr/share/sumo}\" ROS_LOG_DIR=%s\n"
+        "unset ROS_HOSTNAME  # ROS_IP below names each host\n"
+        "# A master port of this job's own: several jobs may share a host.\n"
+        "port=$((20000 + ${SLURM_JOB_ID:-0} %% 20000))\n"
+        "master_ip=$(hostname -I | awk '{print $1}')\n"
+        "export ROS_MASTER_URI=\"http://$master_ip:$port\" ROS_IP=\"$master_ip\"\n"
+        "roslaunch -p \"$port\" %s >>%s 2>&1 &\n"
+        "server=$!\n"
+        "# Each task: its host's own address, then its simulation.\n"
+        "srun --kill-on-bad-exit=1 bash -c '\n"
+        "  export ROS_IP=$(hostname -I | awk \"{print \\$1}\")\n"
+        "  case \"$SLURM_PROCID\" in\n"
+        "%s"
+        "  esac'\n"
+        "status=$?\n"
+        "kill -INT \"$server\"; wait \"$server\"\n"
+        "cd %s && /usr/bin/python3 -c 'import sys; sys.path[:0] = [\"tools\"]; from palcas_cli import train; "
+        "train.merge_simulation_episodes(sys.argv[1], int(sys.argv[2]))' %s %d\n"
+        "exit $status\n"
+        % (count, q(os.path.join(out, SLURM_SCRIPT)), count, seed, SIMULATION_SEED_STRIDE, root, out, out, count, out,
+           q(root), q(os.path.join(out, "ros_log")), server, q(os.path.join(out, "console.log")),
+           "".join(cases).replace("'", "'\\''"), q(root), q(out), count))
+    path = os.path.join(out, SLURM_SCRIPT)
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, 0o755)
+    return path
+
+
 def run_launches(out, opts, record, resume, command_line):
     """The launch loop: one roslaunch for the episodes left (one per episode when demand or
     PR is drawn per episode); a simulation that died ends that episode only (the nodes
@@ -300,21 +602,8 @@ def run_launches(out, opts, record, resume, command_line):
         count = 1 if sampled(opts) else episodes - nxt
         if sampled(opts):
             log("episode %d: demand %s, pr %s%%" % (nxt + 1, value_text(draw["demand_vphpl"]), number_text(draw["pr"])))
-        launch_args = [
-            "arm:=%s" % opts["arm"], "mode:=train", "pr:=%s" % number_text(draw["pr"]), "seed:=%d" % seed,
-            "demand:=%s" % ("scenario" if draw["demand_vphpl"] is None else number_text(draw["demand_vphpl"])),
-            "ramp_demand:=%s" % ("scenario" if opts.get("ramp_demand") is None else number_text(opts["ramp_demand"])),
-            "scenario:=%s" % opts["scenario"], "clusters:=%d" % clusters, "episodes:=%d" % count,
-            "first_episode:=%d" % nxt, "duration:=%s" % number_text(opts["duration"]),
-            "checkpoint_dir:=%s" % policy_folder.checkpoints(out), "resume:=%s" % resume_nodes,
-            "out_dir:=%s" % out, "learning_params:=%s" % (opts.get("learning") or "none"),
-            "rsu_params:=%s" % (opts.get("rsu_params") or "none"),
-            "bridge_params:=%s" % (opts.get("bridge_params") or "none"),
-            "v2x_params:=%s" % (opts.get("v2x_params") or "none"),
-            "paper_printed:=%s" % str(bool(opts.get("paper_printed"))).lower(), "auth_key_file:=%s" % auth_key,
-            "inprocess:=%s" % str(bool(opts.get("inprocess"))).lower(),
-            "trajectory_period_steps:=%d" % (10 if opts.get("record_decisions") else 0),
-            "git_commit:=%s" % record["git_commit"], "command_line:=%s" % command_line]
+        launch_args = system_launch_args(opts, record, command_line, draw, seed, clusters, count, nxt, resume_nodes,
+                                         out, out, auth_key)
         train_launch = launch.Launch(["palcas_launch", "system.launch"] + launch_args, os.path.join(out, "console.log"),
                                      os.path.join(out, "ros_log"), append=True).start()
         monitor = subprocess.Popen(
@@ -401,7 +690,40 @@ def check(argv):
     # How it runs and what it records, not what it learns: any launch may choose.
     opts["inprocess"] = bool(given.get("inprocess"))
     opts["record_decisions"] = bool(given.get("record_decisions"))
+    opts["simulations"] = settle_simulations(given, record, out, opts)
+    opts["plan"] = bool(given.get("plan"))
+    if opts["plan"] and (opts["simulations"] == 1 or resume):
+        raise OptionError("--plan: writes the Slurm job of a new training of several simulations (give "
+                          "--simulations K with K > 1, without --resume)")
     return opts, record, out, resume
+
+
+def settle_simulations(given, record, out, opts):
+    """--simulations K: given, or a resumed training's own (1 for a record without it); K > 1
+    needs a federated arm, one demand and PR for every episode (the simulations' launches run
+    many episodes each) and at most SIMULATION_SEED_STRIDE episodes. Runs the RSUs in
+    process. Raises OptionError."""
+    count = (options.integer_in("--simulations", given["simulations"], 1, MAX_SIMULATIONS)
+             if given.get("simulations") is not None else None)
+    if record is not None:
+        recorded = int(record.get("simulations", 1))
+        if count is not None and count != recorded:
+            raise OptionError("--resume: '%s' trained with --simulations %d, not --simulations %d (leave "
+                              "--simulations out to continue it)" % (out, recorded, count))
+        count = recorded
+    count = count or 1
+    if count == 1:
+        return 1
+    if not palcas_arms.ARMS[opts["arm"]].get("federation"):
+        raise OptionError("--simulations %d: arm %s has no federation to share (a federated arm, e.g. palcas)"
+                          % (count, opts["arm"]))
+    if sampled(opts):
+        raise OptionError("--simulations %d: not with --demand-range or --pr-range (give --demand / --pr)" % count)
+    if int(opts["episodes"]) > SIMULATION_SEED_STRIDE:
+        raise OptionError("--simulations %d: at most %d --episodes per simulation (simulation k's episodes run "
+                          "seeds seed + %d k + e)" % (count, SIMULATION_SEED_STRIDE, SIMULATION_SEED_STRIDE))
+    opts["inprocess"] = True  # each simulation's RSUs live in its bridge, on its clock
+    return count
 
 
 def main(argv):
@@ -411,7 +733,7 @@ def main(argv):
         opts["arm"], datetime.datetime.now().strftime("%Y%m%d-%H%M%S")))
     os.makedirs(policy_folder.checkpoints(out), exist_ok=True)
     out = os.path.abspath(out)
-    if resume and episodes_done(out) >= int(opts["episodes"]):
+    if resume and training_episodes_done(out, opts) >= int(opts["episodes"]):
         log("all %d episodes done in %s" % (int(opts["episodes"]), out))
         return 0
     if not resume:
@@ -427,8 +749,13 @@ def main(argv):
         opts["learning"] = schedule
     command_line = "./palcas train " + " ".join(argv)
     record = write_record(out, opts, launch.git_commit(), command_line, resume)
+    if opts.get("plan"):
+        log("Slurm job of %d simulations: sbatch %s; then ./palcas run --policy %s"
+            % (simulation_count(opts), write_slurm_script(out, opts, record, command_line), out))
+        return 0
     try:
-        status = run_launches(out, opts, record, resume, command_line)
+        run = run_simulations if simulation_count(opts) > 1 else run_launches
+        status = run(out, opts, record, resume, command_line)
     except launch.Interrupted as stop:
         log("interrupted (%s): every node stopped and checkpointed; continue with "
             "./palcas train --resume --out %s" % (stop.signal, out))
