@@ -17,16 +17,16 @@ import palcas_env
 def evaluate(policy="shipped", scenario="paper", seed=101, duration_s=1800.0, pr=60, demand=None, out_dir=None,
              arm="palcas"):
     """metrics.json of one episode of `policy` (a dict), and the environment's run folder."""
-    env = palcas_env.ParallelEnv(scenario=scenario, arm=arm, mode="eval", pr=pr, demand=demand, seed=seed,
-                                 duration_s=duration_s, out_dir=out_dir, policy=policy)
-    decider = palcas_env.Policy.load(policy, env)
-    observations, _ = env.reset(seed=seed)
-    decisions = 0
-    while env.agents:
-        actions = decider.act({agent: observations[agent] for agent in env.agents})
-        decisions += len(actions)
-        observations, _, _, _, _ = env.step(actions)
-    return env.metrics(), env.out_dir, decisions
+    with palcas_env.ParallelEnv(scenario=scenario, arm=arm, mode="eval", pr=pr, demand=demand, seed=seed,
+                                duration_s=duration_s, out_dir=out_dir, policy=policy) as env:
+        decider = palcas_env.Policy.load(policy, env)
+        observations, _ = env.reset(seed=seed)
+        decisions = 0
+        while env.agents:
+            actions = decider.act({agent: observations[agent] for agent in env.agents})
+            decisions += len(actions)
+            observations, _, _, _, _ = env.step(actions)
+        return env.metrics(), env.out_dir, decisions
 
 
 def main():

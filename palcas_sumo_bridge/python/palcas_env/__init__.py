@@ -94,15 +94,21 @@ class ParallelEnv:
         tree, self.rsu_ids = _params.build(scenario, arm, mode, pr, demand, ramp_demand, seed, duration_s, out_dir,
                                            policy, reproducible, config)
         self._core = ParallelEnvCore(tree, _params.BRIDGE_NS)
+        self._out_dir = self._core.out_dir
         self.agents = []
         self.possible_agents = []  # CAVs enter as traffic does: grows with every new agent
         self._seen = set()
 
     # -- PettingZoo parallel API --
+    def _live(self):
+        if self._core is None:
+            raise RuntimeError("this ParallelEnv is closed")
+        return self._core
+
     def reset(self, seed=None, options=None):
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
             raise ValueError("seed must be a non-negative integer or None, got %r" % (seed,))
-        result = self._core.reset(None if seed is None else int(seed))
+        result = self._live().reset(None if seed is None else int(seed))
         observations, _, _, _, infos = self._unpack(result)
         return observations, infos
 
@@ -111,42 +117,51 @@ class ParallelEnv:
             raise TypeError("actions must be a dict {agent: (advisory_index, acceleration)}, got %s"
                             % type(actions).__name__)
         checked = {str(agent): _action(agent, a) for agent, a in actions.items()}
-        return self._unpack(self._core.step(checked))
+        return self._unpack(self._live().step(checked))
 
     def observation_space(self, agent):
         """The observation's shape and dtype (no gymnasium here): the paper's state vector."""
-        return {"shape": (self._core.state_size,), "dtype": np.float32}
+        return {"shape": (self._live().state_size,), "dtype": np.float32}
 
     def action_space(self, agent):
         """The hybrid action: an advisory index (ADVISORY_NAMES) and an acceleration that
         ACCELERATE holds, within the RSU's bounds [m/s^2]."""
         rsu = agent.split("/", 1)[0] if agent else self.rsu_ids[0]
-        low, high = self._core.accel_bounds(rsu)
+        low, high = self._live().accel_bounds(rsu)
         return {"advisory": tuple(range(4)), "acceleration": (float(low), float(high))}
 
     # -- more --
     @property
     def state_size(self):
-        return self._core.state_size
+        return self._live().state_size
 
     @property
     def out_dir(self):
-        return self._core.out_dir
+        return self._out_dir
 
     @property
     def decision_period_steps(self):
-        return self._core.decision_period_steps
+        return self._live().decision_period_steps
 
     def metrics(self):
         """The last finished episode's metrics.json (the bridge's own writer), as a dict."""
-        path = os.path.join(self._core.out_dir, "metrics.json")
+        path = os.path.join(self._out_dir, "metrics.json")
         if not os.path.isfile(path):
             raise RuntimeError("no episode finished yet: metrics.json is written at the episode's end")
         with open(path) as f:
             return json.load(f)
 
     def close(self):
+        """Ends SUMO (libsumo runs one simulation per process: close an environment before
+        making the next; a dropped environment closes too)."""
         self._core = None
+        self.agents = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
     def _unpack(self, result):
         observations, rewards, terminations, truncations, header, agents = result
@@ -175,7 +190,7 @@ class Policy:
         environment's state size (its road's lane count)."""
         if folder == "shipped":
             folder = os.path.join(_params.policies_dir(), env.arm)
-        return cls(PolicyCore(str(folder), env._core), env)
+        return cls(PolicyCore(str(folder), env._live()), env)
 
     @property
     def model_files(self):

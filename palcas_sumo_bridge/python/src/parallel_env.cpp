@@ -84,7 +84,16 @@ std::pair<std::string, std::string> splitAgent(const std::string& agent) {
   return {agent.substr(0, slash), agent.substr(slash + 1)};
 }
 
+namespace {
+// libsumo holds one simulation per process: a second session would load over the first, and
+// the first one's end would close the second's.
+const ParallelEnvCore* live_env = nullptr;
+}  // namespace
+
 ParallelEnvCore::ParallelEnvCore(const EnvParams& params) {
+  if (live_env)
+    throw std::runtime_error("palcas_env: another ParallelEnv is open in this process; close() it first "
+                             "(libsumo runs one simulation per process)");
   if (!params.tree) throw std::invalid_argument("palcas_env: no parameters");
   bridge_ = bridge::loadBridgeOptions(ros::NodeHandle(params.tree, params.bridge_ns));
   if (bridge_.v2x.enabled)
@@ -137,9 +146,12 @@ ParallelEnvCore::ParallelEnvCore(const EnvParams& params) {
     if (!runner_->lockstep().registerRsu(r.options.controller.rsu_id, &reason, static_cast<std::uint32_t>(period_)))
       throw std::runtime_error("palcas_env: RSU '" + r.options.controller.rsu_id + "' not registered: " + reason);
   }
+  live_env = this;
 }
 
-ParallelEnvCore::~ParallelEnvCore() = default;
+ParallelEnvCore::~ParallelEnvCore() {
+  if (live_env == this) live_env = nullptr;
+}
 
 int ParallelEnvCore::stateSize() const { return StateLayout(numLanes()).size(); }
 int ParallelEnvCore::numLanes() const { return runner_->session().road().numMainLanes(); }
