@@ -7,7 +7,6 @@
 #include <pybind11/stl.h>
 
 #include <palcas_core/common/build_info.h>
-#include <palcas_sim/sumo_session.h>
 
 #include <cmath>
 #include <memory>
