@@ -106,8 +106,9 @@ class ParallelEnv:
         return self._core
 
     def reset(self, seed=None, options=None):
-        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-            raise ValueError("seed must be a non-negative integer or None, got %r" % (seed,))
+        if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
+                                 or not 0 <= seed <= 2147483647):
+            raise ValueError("seed must be an integer in 0..2147483647 (as ~scenario/seed) or None, got %r" % (seed,))
         result = self._live().reset(None if seed is None else int(seed))
         observations, _, _, _, infos = self._unpack(result)
         return observations, infos

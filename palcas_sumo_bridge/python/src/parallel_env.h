@@ -68,8 +68,9 @@ struct EnvParams {
 class ParallelEnvCore : private sim::EpisodePort {
  public:
   /// Loads the bridge's and every expected RSU's options with the nodes' loaders (errors
-  /// name the parameter), checks what the module supports (no V2X channel, no federation
-  /// rounds, RSUs of one decision period), generates the scenario. SUMO starts at reset().
+  /// name the parameter), checks what the module supports (no V2X channel, no gui, RSUs of
+  /// one decision period), generates the scenario and starts SUMO for episode 0 (as the
+  /// bridge node does). One at a time per process (libsumo): a second throws.
   explicit ParallelEnvCore(const EnvParams& params);
   ~ParallelEnvCore() override;
 

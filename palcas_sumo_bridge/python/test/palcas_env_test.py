@@ -151,6 +151,11 @@ class Api(TmpDir):
                 with self.assertRaises(error) as caught:
                     env.step(actions)
                 self.assertIn(named, str(caught.exception))
+        for seed in (-1, 2 ** 31, 1.5, "7"):
+            with self.subTest(seed=seed):
+                with self.assertRaises(ValueError) as caught:
+                    env.reset(seed=seed)
+                self.assertIn("seed", str(caught.exception))
         self.assertEqual(env.agents[0], agent)  # nothing applied
         observations, rewards, terminations, truncations, infos = env.step(keep)
         self.assertTrue(env.agents)
