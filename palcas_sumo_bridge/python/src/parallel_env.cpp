@@ -469,6 +469,11 @@ std::string checkpointsOf(const std::string& folder) {
 PolicyCore::PolicyCore(const std::string& folder, const ParallelEnvCore& env) {
   const std::string checkpoints = checkpointsOf(folder);
   for (const std::string& id : env.rsuIds()) {
+    // With rsu/rule_residual the RSU decides the network over the rule (actOverDefaults), not
+    // the greedy act() this class reproduces.
+    if (env.rsuOptions(id).controller.rule_residual)
+      throw std::invalid_argument("policy '" + folder + "': " + id +
+                                  " runs with rsu/rule_residual, which Policy does not reproduce");
     const std::string file = rsu::policyFileIn(checkpoints, id);
     auto agent = std::make_unique<PdqnAgent>(env.rsuOptions(id).controller.pdqn);
     try {
