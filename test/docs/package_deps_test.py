@@ -37,12 +37,13 @@ PACKAGE_DIRS = ["src", "palcas_msgs", "palcas_common", "palcas_rsu", "palcas_fed
                 "palcas_sumo_bridge", "launch", "config", "policies", "test"]
 # find_package names that are not ROS package names -> their rosdep key.
 ROSDEP = {"Eigen3": "eigen", "OpenSSL": "libssl-dev", "nlohmann_json": "nlohmann-json-dev",
-          "GTest": "gtest", "rostest": "rostest", "catkin": None, "OpenMP": None}
+          "GTest": "gtest", "rostest": "rostest", "catkin": None, "OpenMP": None, "pybind11": "pybind11-dev",
+          "Python3": "python3-dev"}
 # Include prefixes that are no ROS package: the C++ and system libraries, or inside another.
 NOT_PACKAGES = {"sys", "netinet", "openssl", "nlohmann", "gtest", "ros", "xmlrpcpp", "libsumo", "Eigen",
                 "benchmark", "boost", "gmock"}
 # A header folder that belongs to another package.
-INCLUDE_PACKAGE = {"libsumo": "sumo", "nlohmann": "nlohmann-json-dev", "openssl": "libssl-dev",
+INCLUDE_PACKAGE = {"libsumo": "sumo", "nlohmann": "nlohmann-json-dev", "openssl": "libssl-dev", "pybind11": "pybind11-dev",
                    "ros": "roscpp", "xmlrpcpp": "roscpp"}
 
 

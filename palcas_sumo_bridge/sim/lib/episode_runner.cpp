@@ -236,36 +236,49 @@ void EpisodeRunner::actuate(EpisodePort& port) {
 }
 
 EpisodeRun EpisodeRunner::runEpisode(int episode, EpisodePort& port) {
+  beginEpisode(episode, port);
+  while (advance(port)) {
+  }
+  return finishEpisode(port);
+}
+
+void EpisodeRunner::beginEpisode(int episode, EpisodePort& port) {
   wall_start_ = Clock::now();
-  double next_progress_s = options_.metrics_period_s;
+  next_progress_s_ = options_.metrics_period_s;
   recorder_.reset();
   if (options_.trajectory_period_steps > 0)
     recorder_ = std::make_unique<RunRecorder>(options_.episode_dir(episode), options_.trajectory_period_steps);
   publishStep(port);
-  while (port.running() && session_->timeS() < options_.duration_s - 1e-9) {
-    const auto t_wait = Clock::now();
-    if (lockstep_.enabled()) waitForAnswers(port);
-    actuate(port);
-    const auto t0 = Clock::now();
-    session_->step();
-    const auto t1 = Clock::now();
-    publishStep(port);
-    port.stepped(*session_);
-    if (recorder_) recorder_->addStep(session_->stepCount(), session_->timeS(), session_->vehicles());
-    const auto t2 = Clock::now();
-    run_.timing.add(session_->vehicles().size(), secondsBetween(t0, t1), secondsBetween(t1, t2),
-                    secondsBetween(t_wait, t0));
-    if (session_->timeS() >= next_progress_s - 1e-9) {
-      port.progress(*session_);
-      next_progress_s += options_.metrics_period_s;
-    }
-    if (options_.real_time_factor > 0.0) {
-      const double ahead_s = session_->timeS() / options_.real_time_factor - wallSeconds();
-      if (ahead_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(ahead_s));
-    }
+}
+
+bool EpisodeRunner::advance(EpisodePort& port) {
+  if (!port.running() || session_->timeS() >= options_.duration_s - 1e-9) return false;
+  const auto t_wait = Clock::now();
+  if (lockstep_.enabled()) waitForAnswers(port);
+  actuate(port);
+  const auto t0 = Clock::now();
+  session_->step();
+  const auto t1 = Clock::now();
+  publishStep(port);
+  port.stepped(*session_);
+  if (recorder_) recorder_->addStep(session_->stepCount(), session_->timeS(), session_->vehicles());
+  const auto t2 = Clock::now();
+  run_.timing.add(session_->vehicles().size(), secondsBetween(t0, t1), secondsBetween(t1, t2),
+                  secondsBetween(t_wait, t0));
+  if (session_->timeS() >= next_progress_s_ - 1e-9) {
+    port.progress(*session_);
+    next_progress_s_ += options_.metrics_period_s;
   }
+  if (options_.real_time_factor > 0.0) {
+    const double ahead_s = session_->timeS() / options_.real_time_factor - wallSeconds();
+    if (ahead_s > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(ahead_s));
+  }
+  return port.running() && session_->timeS() < options_.duration_s - 1e-9;
+}
+
+EpisodeRun EpisodeRunner::finishEpisode(EpisodePort& port) {
   // The final state, unless the periodic report just covered it.
-  if (std::abs(session_->timeS() - (next_progress_s - options_.metrics_period_s)) > 1e-9) port.progress(*session_);
+  if (std::abs(session_->timeS() - (next_progress_s_ - options_.metrics_period_s)) > 1e-9) port.progress(*session_);
   if (recorder_) recorder_->close();
   run_.steps = session_->stepCount();
   run_.wall_s = wallSeconds();

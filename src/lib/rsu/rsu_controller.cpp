@@ -215,9 +215,41 @@ void RsuController::learn() {
   if (options_.train) runGradientSteps();
 }
 
+DecisionView RsuController::preview(const RoadSnapshot& snapshot, uint64_t step,
+                                    const GlobalDensities& global, const VehicleOutcomes& outcomes) const {
+  if (snapshot.num_lanes != options_.num_lanes)
+    throw std::invalid_argument("RsuController::preview: snapshot num_lanes = " +
+                                std::to_string(snapshot.num_lanes) + ", this RSU has " +
+                                std::to_string(options_.num_lanes));
+  Observation obs = observe(snapshot, global, outcomes);
+  DecisionView view;
+  view.member_ids = std::move(obs.member_ids);
+  view.member_lanes = std::move(obs.member_lanes);
+  // The rule arm builds no states; an outside learner needs them.
+  view.states = obs.member_states.cols() == static_cast<nn::Index>(view.member_ids.size())
+                    ? std::move(obs.member_states)
+                    : builder_.buildStates(NeighbourFinder(snapshot), view.member_ids,
+                                           obs.cluster.toClusterStats(), global);
+  // As advise() would: a step not after the previous one starts an episode and closes nothing.
+  if (!(have_last_step_ && step <= last_step_)) view.closures = std::move(obs.closings.closures);
+  return view;
+}
+
 DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                                      const GlobalDensities& global,
                                      const VehicleOutcomes& outcomes) {
+  return adviseImpl(snapshot, step, time_s, global, outcomes, nullptr);
+}
+
+DecisionOutput RsuController::adviseWith(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                                         const GlobalDensities& global, const VehicleOutcomes& outcomes,
+                                         const std::vector<Decision>& decisions) {
+  return adviseImpl(snapshot, step, time_s, global, outcomes, &decisions);
+}
+
+DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                                         const GlobalDensities& global, const VehicleOutcomes& outcomes,
+                                         const std::vector<Decision>* given) {
   if (!std::isfinite(time_s) || time_s < 0.0)
     throw std::invalid_argument("RsuController::advise: time_s = " + std::to_string(time_s) +
                                 " must be finite and >= 0");
@@ -226,6 +258,12 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
                                 std::to_string(snapshot.num_lanes) + ", this RSU has " +
                                 std::to_string(options_.num_lanes));
   Observation obs = observe(snapshot, global, outcomes);  // may throw; nothing changed
+  if (given && given->size() != obs.member_ids.size())
+    throw std::invalid_argument("RsuController::adviseWith: " + std::to_string(given->size()) +
+                                " decisions for " + std::to_string(obs.member_ids.size()) + " members");
+  if (given && obs.member_states.cols() != static_cast<nn::Index>(obs.member_ids.size()))
+    obs.member_states = builder_.buildStates(NeighbourFinder(snapshot), obs.member_ids,
+                                             obs.cluster.toClusterStats(), global);
 
   // ---- commit: nothing below throws on validated input ----
   if (have_last_step_ && step <= last_step_) {  // the bridge restarted: a new episode
@@ -242,18 +280,22 @@ DecisionOutput RsuController::advise(const RoadSnapshot& snapshot, uint64_t step
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
   const bool rule_first = options_.advice_source == AdviceSource::kRules || options_.rule_residual;
-  if (rule_first) {
-    decisions.reserve(obs.member_vehicles.size());
-    for (const VehicleSnapshot* v : obs.member_vehicles)
-      decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
-  }
-  if (options_.rule_residual && !obs.member_ids.empty()) {
-    std::vector<Decision> rule;
-    rule.swap(decisions);
-    agent_.actOverDefaults(obs.member_states, options_.train, rule, static_cast<float>(options_.residual_margin),
-                           decisions);
-  } else if (!rule_first && !obs.member_ids.empty()) {
-    agent_.act(obs.member_states, options_.train, decisions);
+  if (given) {
+    decisions = *given;  // from outside (adviseWith): neither the rule nor the network is asked
+  } else {
+    if (rule_first) {
+      decisions.reserve(obs.member_vehicles.size());
+      for (const VehicleSnapshot* v : obs.member_vehicles)
+        decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
+    }
+    if (options_.rule_residual && !obs.member_ids.empty()) {
+      std::vector<Decision> rule;
+      rule.swap(decisions);
+      agent_.actOverDefaults(obs.member_states, options_.train, rule, static_cast<float>(options_.residual_margin),
+                             decisions);
+    } else if (!rule_first && !obs.member_ids.empty()) {
+      agent_.act(obs.member_states, options_.train, decisions);
+    }
   }
   for (size_t i = 0; i < decisions.size(); ++i)
     decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);

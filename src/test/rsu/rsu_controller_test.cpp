@@ -796,6 +796,48 @@ TEST(RsuController, ControllerFileKeepsItsKeysAndLoadsWithoutACheckpointId) {
   EXPECT_EQ(other.stats().decisions, 0u);  // untouched
 }
 
+// preview() + adviseWith() (palcas_env's seam) is advise() with the decisions taken outside.
+TEST(RsuController, AdviseWithTheNetworksDecisionsIsAdvise) {
+  RsuController own(smallOptions(false)), outside(smallOptions(false));
+  for (int call = 0; call < 3; ++call) {
+    const RoadSnapshot r = eightCavs(call);
+    const DecisionOutput a = own.advise(r, 1 + call, 0.1 * (call + 1), GLOBAL, NONE);
+    const palcas::rsu::DecisionView view = outside.preview(r, 1 + call, GLOBAL, NONE);
+    ASSERT_EQ(view.member_ids.size(), a.advisories.size());
+    ASSERT_EQ(view.states.cols(), static_cast<palcas::nn::Index>(a.advisories.size()));
+    std::vector<Decision> given;
+    for (size_t i = 0; i < a.advisories.size(); ++i) {
+      EXPECT_EQ(view.member_ids[i], a.advisories[i].vehicle_id);
+      EXPECT_TRUE(view.states.col(static_cast<palcas::nn::Index>(i)).isApprox(stateOf(smallOptions(), r, view.member_ids[i])));
+      given.push_back(a.advisories[i].decision);
+    }
+    expectSameDecisions(a, outside.adviseWith(r, 1 + call, 0.1 * (call + 1), GLOBAL, NONE, given));
+  }
+}
+
+TEST(RsuController, PreviewShowsTheClosuresAndChangesNothing) {
+  RsuController c(smallOptions());
+  c.adviseWith(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE, {Decision{Action::kKeep, 0.0f}});
+  const RoadSnapshot now = road({cav("a", 1, 920.0)});
+  const palcas::rsu::DecisionView view = c.preview(now, 2, GLOBAL, NONE);
+  const palcas::rsu::DecisionView again = c.preview(now, 2, GLOBAL, NONE);  // nothing changed
+  ASSERT_EQ(view.closures.size(), 1u);
+  ASSERT_EQ(again.closures.size(), 1u);
+  EXPECT_EQ(view.closures[0].id, "a");
+  EXPECT_NEAR(view.closures[0].reward, R_FAST, 1e-6);
+  EXPECT_FALSE(view.closures[0].done);
+  EXPECT_EQ(c.agent().replay().size(), 0u);
+  // The given decisions must match the members; a wrong count changes nothing.
+  expectInvalid([&] { c.adviseWith(now, 2, 0.2, GLOBAL, NONE, {}); }, "0 decisions for 1 members");
+  EXPECT_EQ(c.agent().replay().size(), 0u);
+  const DecisionOutput out = c.adviseWith(now, 2, 0.2, GLOBAL, NONE, {Decision{Action::kLaneRight, 0.0f}});
+  EXPECT_EQ(out.advisories[0].decision.action, Action::kKeep);  // lane 1: no right, masked as advise() does
+  EXPECT_EQ(c.agent().replay().size(), 1u);                     // the transition stored, as advise() would
+  EXPECT_NEAR(c.stats().sum_reward, view.closures[0].reward, 1e-9);
+  // A step not after the last starts an episode: it closes nothing.
+  EXPECT_TRUE(c.preview(now, 1, GLOBAL, NONE).closures.empty());
+}
+
 TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {
   using palcas::rsu::maskImpossibleLaneChange;
   const Decision left{Action::kLaneLeft, 0.0f}, right{Action::kLaneRight, 0.0f};

@@ -118,8 +118,19 @@ class EpisodeRunner {
   /// Closes the current SUMO (one libsumo per process) and loads episode k's; every
   /// per-episode state is reset.
   void startEpisode(int episode);
-  /// Runs the current episode to duration_s or until the port stops running.
+  /// Runs the current episode to duration_s or until the port stops running:
+  /// beginEpisode(), advance() while it returns true, finishEpisode().
   EpisodeRun runEpisode(int episode, EpisodePort& port);
+  /// The same loop a step at a time, for a caller that must return between steps (the
+  /// Python module palcas_env hands each decision step to its caller):
+  /// beginEpisode publishes the episode's first step;
+  void beginEpisode(int episode, EpisodePort& port);
+  /// advance runs one step (wait for answers, actuate, SUMO step, publish the next step) and
+  /// returns whether the episode goes on (false: duration reached or the port stopped; then
+  /// call finishEpisode, nothing else);
+  bool advance(EpisodePort& port);
+  /// finishEpisode closes the recording and returns what the loop measured.
+  EpisodeRun finishEpisode(EpisodePort& port);
 
   enum class Verdict { kQueued, kUnknownRsu, kDuplicate };
   struct AnswerOutcome {
@@ -167,6 +178,7 @@ class EpisodeRunner {
   std::unordered_set<std::string> late_this_step_;
   std::unique_ptr<RunRecorder> recorder_;
   EpisodeRun run_;
+  double next_progress_s_ = 0.0;  ///< simulated time of the next progress report [s]
   std::chrono::steady_clock::time_point wall_start_ = std::chrono::steady_clock::now();
 };
 

@@ -92,6 +92,17 @@ struct DecisionOutput {
   ClusterSummary cluster;               ///< this zone's statistics, for I2I (ClusterState)
 };
 
+/// What a decision would see, before anything changes (preview()): the members in the
+/// order advise() decides them, their states (state_size x members, one column each), their
+/// lanes, and in train mode the transitions the decision would close (each CAV's reward
+/// and whether its transition ends there).
+struct DecisionView {
+  std::vector<std::string> member_ids;
+  nn::Matrix states;
+  std::vector<int> member_lanes;
+  std::vector<Closure> closures;  ///< empty in eval mode and when the step starts an episode
+};
+
 /// Counters and figures for the node's status topics.
 struct RsuControllerStats {
   uint64_t decisions = 0;     ///< decide() calls since construction
@@ -164,6 +175,20 @@ class RsuController {
   /// decide() without the gradient steps (same preconditions and exceptions).
   DecisionOutput advise(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                         const GlobalDensities& global, const VehicleOutcomes& outcomes);
+  /// What advise() on the same arguments would see, without changing anything (an outside
+  /// learner, palcas_env, chooses the decisions from it and passes them to adviseWith()).
+  /// Throws like advise().
+  DecisionView preview(const RoadSnapshot& snapshot, uint64_t step, const GlobalDensities& global,
+                       const VehicleOutcomes& outcomes) const;
+  /// advise() with the members' decisions given from outside (in preview()'s member order)
+  /// instead of the network's or the rule's: the same masking of impossible lane changes and,
+  /// in train mode, the same transitions closed and stored. The agent's act() is not called,
+  /// so exploration and its random numbers are untouched. Throws like advise(), and
+  /// std::invalid_argument when `decisions` has another size than the members (nothing
+  /// changed then).
+  DecisionOutput adviseWith(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                            const GlobalDensities& global, const VehicleOutcomes& outcomes,
+                            const std::vector<Decision>& decisions);
   /// The gradient steps due after one decision (train mode; nothing in eval mode).
   /// Touches only the agent: a node may run it on another thread while it calls
   /// observeStep(), and must join it before the next advise()/decide() or any other call.
@@ -235,6 +260,10 @@ class RsuController {
   /// Remembers the closed transitions (id order) and counts them for the stats and n_k.
   void storeClosures(const std::vector<Closure>& closures);
   void runGradientSteps();
+
+  DecisionOutput adviseImpl(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                            const GlobalDensities& global, const VehicleOutcomes& outcomes,
+                            const std::vector<Decision>* given);
 
   RsuControllerOptions options_;
   StateBuilder builder_;
