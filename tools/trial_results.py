@@ -118,6 +118,7 @@ def read_trial(folder, out_dir=None):
             settings = json.loads((folder / "trial.json").read_text())
         except ValueError as e:
             raise TrialError(f"{folder / 'trial.json'}: not JSON ({e})")
+    name_own_demand(settings)
     rows, seen = [], {}
     for path in files:
         with open(path, newline="") as f:
@@ -159,15 +160,25 @@ def cells_of(rows):
     return cells
 
 
+# How a cell without a demand (the scenario's own, e.g. the printed 3200 + 600) is named:
+# trial.json's own_demand_title / own_demand_short, set when the trial is read.
+OWN_DEMAND = {"title": "the scenario's own demand", "short": "own"}
+
+
+def name_own_demand(settings):
+    OWN_DEMAND["title"] = settings.get("own_demand_title") or "the scenario's own demand"
+    OWN_DEMAND["short"] = settings.get("own_demand_short") or "own"
+
+
 def cell_title(cell):
     demand, pr = cell
-    d = "the scenario's own demand" if demand is None else f"demand {demand:g} veh/h/lane"
+    d = OWN_DEMAND["title"] if demand is None else f"demand {demand:g} veh/h/lane"
     return f"{d}, PR {pr:g} %"
 
 
 def cell_short(cell):
     demand, pr = cell
-    return ("own" if demand is None else f"{demand:g}") + f" / PR {pr:g}"
+    return (OWN_DEMAND["short"] if demand is None else f"{demand:g}") + f" / PR {pr:g}"
 
 
 def done_rows(rows, arm, cell):
@@ -529,7 +540,8 @@ def what_was_run(rows, files, settings, folder, a):
     if settings.get("bridge_params"):
         lines.append(f"- Every point under the bridge override `{settings['bridge_params']}`")
     for key, planned in sorted((settings.get("seeds_by_demand") or {}).items()):
-        lines.append(f"- Seeds at {key} veh/h/lane: {len(planned)} planned, {', '.join(str(x) for x in planned)}")
+        at = OWN_DEMAND["title"] if key == "scenario" else f"{key} veh/h/lane"
+        lines.append(f"- Seeds at {at}: {len(planned)} planned, {', '.join(str(x) for x in planned)}")
     expected = [(arm, c, s) for arm in arms for c in (x["cell"] for x in a["cells"])
                 for s in seeds_for(settings, c, seeds)]
     have = {(r["arm"], (r["demand"], r["pr"]), r["seed"]): r for r in rows}

@@ -196,6 +196,26 @@ class SeedsByDemandTest(unittest.TestCase):
         self.assertFalse([l for l in lines if "2200" in l and "s1003" in l], "no missing point outside the plan")
 
 
+class OwnDemandTest(unittest.TestCase):
+    def tearDown(self):
+        trial_results.name_own_demand({})
+
+    def test_a_cell_at_the_scenarios_own_demand_is_named_from_trial_json(self):
+        cell = (None, 20.0)
+        trial_results.name_own_demand({})
+        self.assertEqual(trial_results.cell_title(cell), "the scenario's own demand, PR 20 %")
+        trial_results.name_own_demand({"own_demand_title": "the printed scenario", "own_demand_short": "printed"})
+        self.assertEqual(trial_results.cell_title(cell), "the printed scenario, PR 20 %")
+        self.assertEqual(trial_results.cell_short(cell), "printed / PR 20")
+        self.assertEqual(trial_results.cell_short((2200.0, 20.0)), "2200 / PR 20")
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings.update(own_demand_title="the printed scenario", seeds_by_demand={"scenario": [1001]})
+        trial_results.name_own_demand(settings)  # as read_trial does
+        a = trial_results.analyse(fixture_rows(), settings, trial_results.load_registry())
+        lines = trial_results.what_was_run(fixture_rows(), [FIXTURE / "results.csv"], settings, FIXTURE, a)
+        self.assertIn("- Seeds at the printed scenario: 1 planned, 1001", lines)
+
+
 class MechanismTest(unittest.TestCase):
     def test_the_real_registry(self):
         import yaml
