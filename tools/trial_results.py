@@ -118,7 +118,6 @@ def read_trial(folder, out_dir=None):
             settings = json.loads((folder / "trial.json").read_text())
         except ValueError as e:
             raise TrialError(f"{folder / 'trial.json'}: not JSON ({e})")
-    name_own_demand(settings)
     rows, seen = [], {}
     for path in files:
         with open(path, newline="") as f:
@@ -161,7 +160,7 @@ def cells_of(rows):
 
 
 # How a cell without a demand (the scenario's own, e.g. the printed 3200 + 600) is named:
-# trial.json's own_demand_title / own_demand_short, set when the trial is read.
+# trial.json's own_demand_title / own_demand_short, set by generate() for its page and figures.
 OWN_DEMAND = {"title": "the scenario's own demand", "short": "own"}
 
 
@@ -540,7 +539,8 @@ def what_was_run(rows, files, settings, folder, a):
     if settings.get("bridge_params"):
         lines.append(f"- Every point under the bridge override `{settings['bridge_params']}`")
     for key, planned in sorted((settings.get("seeds_by_demand") or {}).items()):
-        at = OWN_DEMAND["title"] if key == "scenario" else f"{key} veh/h/lane"
+        own = settings.get("own_demand_title") or "the scenario's own demand"
+        at = own if key == "scenario" else f"{key} veh/h/lane"
         lines.append(f"- Seeds at {at}: {len(planned)} planned, {', '.join(str(x) for x in planned)}")
     expected = [(arm, c, s) for arm in arms for c in (x["cell"] for x in a["cells"])
                 for s in seeds_for(settings, c, seeds)]
@@ -885,6 +885,7 @@ def command_line(folder, out_dir):
 def generate(folder, out_dir):
     """{relative path: text} of the page and its CSVs, and the analysis (for the figures)."""
     rows, files, settings = read_trial(folder, out_dir)
+    name_own_demand(settings)  # for the page's cell names and the figures drawn after it
     registry = load_registry()
     a = analyse(rows, settings, registry)
     page = ["# Results of the fair trial", "",

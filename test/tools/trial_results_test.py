@@ -210,7 +210,6 @@ class OwnDemandTest(unittest.TestCase):
         self.assertEqual(trial_results.cell_short((2200.0, 20.0)), "2200 / PR 20")
         settings = json.loads((FIXTURE / "trial.json").read_text())
         settings.update(own_demand_title="the printed scenario", seeds_by_demand={"scenario": [1001]})
-        trial_results.name_own_demand(settings)  # as read_trial does
         a = trial_results.analyse(fixture_rows(), settings, trial_results.load_registry())
         lines = trial_results.what_was_run(fixture_rows(), [FIXTURE / "results.csv"], settings, FIXTURE, a)
         self.assertIn("- Seeds at the printed scenario: 1 planned, 1001", lines)
