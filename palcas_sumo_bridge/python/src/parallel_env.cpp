@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "palcas_sumo_bridge/msg_conversion.h"
+#include "palcas_rsu/msg_conversion.h"
 #include "palcas_sumo_bridge/run_files.h"
 
 namespace palcas::pyenv {
@@ -35,34 +36,6 @@ sim::RunnerOptions runnerOptions(const bridge::BridgeOptions& o) {
   r.trajectory_period_steps = o.trajectory_period_steps;
   r.episode_dir = [o](int episode) { return bridge::episodeDir(o, episode); };
   return r;
-}
-
-// As palcas_rsu's toSnapshot (msg_conversion.cpp): the RSU sees the published state.
-RoadSnapshot toSnapshot(const palcas_msgs::VehicleStateArray& states) {
-  RoadSnapshot snapshot;
-  snapshot.num_lanes = states.num_lanes;
-  snapshot.vehicles.reserve(states.vehicles.size());
-  for (const auto& s : states.vehicles) {
-    VehicleSnapshot v;
-    v.id = s.id;
-    v.is_cav = s.is_cav;
-    v.lane = s.lane;
-    v.x_m = s.x_m;
-    v.lateral_m = s.lateral_m;
-    v.speed_mps = s.speed_mps;
-    v.accel_mps2 = s.accel_mps2;
-    v.lateral_speed_mps = s.lateral_speed_mps;
-    v.length_m = s.length_m;
-    v.width_m = s.width_m;
-    v.distance_to_exit_m = s.distance_to_exit_m;
-    v.on_accel_lane = s.on_accel_lane;
-    v.accel_lane_pos_m = s.accel_lane_pos_m;
-    v.accel_lane_length_m = s.accel_lane_length_m;
-    v.max_speed_mps = s.max_speed_mps;
-    v.driving_itself = s.driving_itself;
-    snapshot.vehicles.push_back(std::move(v));
-  }
-  return snapshot;
 }
 
 std::vector<float> column(const nn::Matrix& m, nn::Index j) {
@@ -235,7 +208,7 @@ void ParallelEnvCore::publishStep(const sim::SumoSession& session) {
     r.due = r.schedule->decidesAt(step);
     const bool observe = r.schedule->observesBetweenDecisions() || (r.rewards && r.options.controller.reward_over_period);
     if (!r.due && !observe) continue;
-    if (!snapshot) snapshot = toSnapshot(current_);
+    if (!snapshot) snapshot = rsu::toSnapshot(current_);
     if (!r.due) {
       if (r.schedule->observesBetweenDecisions()) r.controller->observeStep(*snapshot);
       if (r.rewards) r.rewards->observeStep(*snapshot);
@@ -357,7 +330,7 @@ void ParallelEnvCore::applyDecisions(const std::map<std::string, AgentAction>& a
   const double now_s = current_.header.stamp.toSec();
   const float decision_ms =
       static_cast<float>(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - decision_open_).count());
-  const RoadSnapshot snapshot = toSnapshot(current_);
+  const RoadSnapshot snapshot = rsu::toSnapshot(current_);
   struct Sent {
     const Rsu* from;
     double density;
