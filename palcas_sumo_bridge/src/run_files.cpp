@@ -226,6 +226,23 @@ std::string episodeDir(const BridgeOptions& o, int episode) {
   return several ? o.out_dir + "/episode_" + std::to_string(episode) : o.out_dir;
 }
 
+sim::RunnerOptions runnerOptions(const BridgeOptions& o) {
+  sim::RunnerOptions r;
+  r.duration_s = o.scenario.duration_s;
+  r.expected_rsus = o.expected_rsus;
+  r.lost_after_missed_steps = o.lost_after_missed_steps;
+  r.lockstep_deadline_s = o.lockstep_deadline_s;
+  r.max_advisory_age_steps = static_cast<std::uint64_t>(o.max_advisory_age_steps);
+  r.advisory_hold_steps = static_cast<std::uint64_t>(o.advisory_hold_steps);
+  r.real_time_factor = o.real_time_factor;
+  r.metrics_period_s = o.metrics_period_s;
+  r.v2x = o.v2x;
+  r.step_length_s = o.scenario.step_length_s;
+  r.trajectory_period_steps = o.trajectory_period_steps;
+  r.episode_dir = [o](int episode) { return episodeDir(o, episode); };
+  return r;
+}
+
 sim::SessionOptions sessionOptionsFor(const BridgeOptions& o, const std::string& sumocfg,
                                       int episode) {
   sim::SessionOptions s = o.session;

@@ -49,6 +49,11 @@ std::string prepareScenario(const BridgeOptions& options);
 /// several episodes (or continues a training), so each keeps its own.
 std::string episodeDir(const BridgeOptions& options, int episode);
 
+/// The episode loop's options from the bridge's (duration, lockstep, holds, V2X, recording,
+/// episodeDir): one mapping for the bridge node and the Python environment, which run the
+/// same loop.
+sim::RunnerOptions runnerOptions(const BridgeOptions& options);
+
 /// SUMO session options for a generated scenario; episode k runs with SUMO seed + k and
 /// writes the SUMO outputs named in options.sumo_outputs into episodeDir (created here).
 sim::SessionOptions sessionOptionsFor(const BridgeOptions& options, const std::string& sumocfg,

@@ -20,24 +20,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// As the bridge node's runnerOptions (bridge_node.cpp): the same loop, pacing and holds.
-sim::RunnerOptions runnerOptions(const bridge::BridgeOptions& o) {
-  sim::RunnerOptions r;
-  r.duration_s = o.scenario.duration_s;
-  r.expected_rsus = o.expected_rsus;
-  r.lost_after_missed_steps = o.lost_after_missed_steps;
-  r.lockstep_deadline_s = o.lockstep_deadline_s;
-  r.max_advisory_age_steps = static_cast<std::uint64_t>(o.max_advisory_age_steps);
-  r.advisory_hold_steps = static_cast<std::uint64_t>(o.advisory_hold_steps);
-  r.real_time_factor = o.real_time_factor;
-  r.metrics_period_s = o.metrics_period_s;
-  r.v2x = o.v2x;
-  r.step_length_s = o.scenario.step_length_s;
-  r.trajectory_period_steps = o.trajectory_period_steps;
-  r.episode_dir = [o](int episode) { return bridge::episodeDir(o, episode); };
-  return r;
-}
-
 std::vector<float> column(const nn::Matrix& m, nn::Index j) {
   std::vector<float> out(static_cast<std::size_t>(m.rows()));
   for (nn::Index i = 0; i < m.rows(); ++i) out[static_cast<std::size_t>(i)] = m(i, j);
@@ -76,7 +58,7 @@ ParallelEnvCore::ParallelEnvCore(const EnvParams& params) {
   if (bridge_.out_dir.empty()) throw std::invalid_argument("palcas_env: out_dir is empty");
   fs::create_directories(bridge_.out_dir);
   sumocfg_ = bridge::prepareScenario(bridge_);
-  runner_ = std::make_unique<sim::EpisodeRunner>(runnerOptions(bridge_), [this](int episode) {
+  runner_ = std::make_unique<sim::EpisodeRunner>(bridge::runnerOptions(bridge_), [this](int episode) {
     return std::make_unique<sim::SumoSession>(bridge::sessionOptionsFor(bridge_, sumocfg_, episode));
   });
   const sim::SumoSession& session = runner_->session();
