@@ -295,6 +295,22 @@ class ConsoleLog(unittest.TestCase):
         self.assertEqual(launch.node_deaths(text + loop),
                          ["fedserver-3 (exit code -6, died 3 times)", "rsu_1/rsu-5 (exit code 1)"])
 
+    def test_a_restart_cut_short_by_the_simulations_crash_is_not_lost(self):
+        progress = "[ INFO] [1.0, 60.0]: palcas bridge: episode %d/3  t=  60/1200 s\n"
+        killed = "[fedserver-2] process has died [pid 7, exit code -9, cmd x]\n"
+        crash = "[palcas_sumo_bridge-1] process has died [pid 5, exit code -6, cmd x]\n"
+        self.assertEqual(launch.node_deaths(progress % 2 + killed + crash, crashed_by="palcas_sumo_bridge"),
+                         ["palcas_sumo_bridge-1 (exit code -6)"], "its restart was pending in the crashed episode")
+        self.assertEqual(launch.node_deaths(progress % 2 + killed + crash), ["fedserver-2 (exit code -9)",
+                         "palcas_sumo_bridge-1 (exit code -6)"], "without crashed_by as before")
+        self.assertEqual(launch.node_deaths(progress % 1 + killed + progress % 2 + crash, crashed_by="palcas_sumo_bridge"),
+                         ["fedserver-2 (exit code -9)", "palcas_sumo_bridge-1 (exit code -6)"],
+                         "dead for a whole episode the simulation finished: lost")
+        loop = "".join("[fedserver-2] process has died [pid %d, exit code -6, cmd x]\n"
+                       "[fedserver-2] restarting process\n" % k for k in range(3))
+        self.assertIn("fedserver-2 (exit code -6, died 3 times)",
+                      launch.node_deaths(progress % 2 + loop + crash, crashed_by="palcas_sumo_bridge"))
+
     def test_a_clean_exit_is_not_a_death(self):
         self.assertEqual(launch.node_deaths("[rsu_0/rsu-4] process has died [pid 1, exit code 0, cmd x]\n"), [])
 

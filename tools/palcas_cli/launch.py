@@ -73,22 +73,47 @@ def read_text(path):
         return ""
 
 
-def node_deaths(console_text):
+def node_deaths(console_text, crashed_by=None):
     """Nodes of a roslaunch console that died for good: a non-zero exit that roslaunch did not
     follow with a restart (respawn), or three deaths (a crash loop); a node that died once and
-    came back is not lost. 'name (exit code N[, died k times])', sorted by name."""
+    came back is not lost. 'name (exit code N[, died k times])', sorted by name.
+
+    crashed_by: the name prefix of the node whose crash ends the launch (the bridge, whose SUMO
+    can abort). A node that died in the same episode as that crash, after it, or just before it
+    with its restart still pending, was not lost: the launch ended before roslaunch could
+    restart it, and the next launch starts every node afresh. Episodes come from the bridge's
+    progress lines ('palcas bridge: episode k/n')."""
     text = ANSI.sub("", console_text)
-    deaths, restarts, codes = {}, {}, {}
+    events = []  # (position, kind, node, exit code); kind: death | restart | episode
     for m in re.finditer(r"\[([^\[\]\s]+)\] process has died \[pid \d+, exit code (-?\d+)", text):
         if m.group(2) != "0":
-            deaths[m.group(1)] = deaths.get(m.group(1), 0) + 1
-            codes[m.group(1)] = m.group(2)
+            events.append((m.start(), "death", m.group(1), m.group(2)))
     for m in re.finditer(r"\[([^\[\]\s]+)\] restarting process", text):
-        restarts[m.group(1)] = restarts.get(m.group(1), 0) + 1
+        events.append((m.start(), "restart", m.group(1), None))
+    for m in re.finditer(r"palcas bridge: episode (\d+)/", text):
+        events.append((m.start(), "episode", m.group(1), None))
+    events.sort()
+    crash = next((i for i, e in enumerate(events)
+                  if crashed_by and e[1] == "death" and e[2].startswith(crashed_by)), None)
+    episode_at, episode = [], None
+    for e in events:
+        episode = e[2] if e[1] == "episode" else episode
+        episode_at.append(episode)
+    deaths, restarts, codes, pending = {}, {}, {}, set()
+    for i, (_, kind, node, code) in enumerate(events):
+        if kind == "death":
+            deaths[node] = deaths.get(node, 0) + 1
+            codes[node] = code
+            if crash is not None and node != events[crash][2] and (i > crash or episode_at[i] == episode_at[crash]):
+                pending.add(node)
+            else:
+                pending.discard(node)
+        elif kind == "restart":
+            restarts[node] = restarts.get(node, 0) + 1
     lost = []
     for node in sorted(deaths):
         d, r = deaths[node], restarts.get(node, 0)
-        if d > r or d >= 3:
+        if d >= 3 or (d > r and node not in pending):
             lost.append("%s (exit code %s%s)" % (node, codes[node], ", died %d times" % d if d > 1 else ""))
     return lost
 

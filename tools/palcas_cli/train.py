@@ -436,7 +436,7 @@ def run_simulations(out, opts, record, resume, command_line):
         console_log = os.path.join(simulation_dir(out, k), "console.log")
         text = launch.read_text(console_log)
         bridge = "sim%d/palcas_sumo_bridge" % k
-        deaths = [d for d in launch.node_deaths(text) if not d.startswith(bridge)]
+        deaths = [d for d in launch.node_deaths(text, crashed_by=bridge) if not d.startswith(bridge)]
         if deaths:
             lost.append("simulation %d lost %s; last error: %s" % (k, ", ".join(deaths), launch.last_fatal(text)))
             return
@@ -622,7 +622,10 @@ def run_launches(out, opts, record, resume, command_line):
         console_text = launch.read_text(os.path.join(out, "console.log"))
         # An RSU or the server that died leaves episodes trained without it: not a training
         # of this arm. Say which node and why, and stop (the simulation's crashes are below).
-        lost = [d for d in launch.node_deaths(console_text) if not d.startswith("palcas_sumo_bridge")]
+        # A node whose restart was still pending when the simulation crashed is not lost: the
+        # next launch starts it afresh (launch.node_deaths' crashed_by).
+        lost = [d for d in launch.node_deaths(console_text, crashed_by="palcas_sumo_bridge")
+                if not d.startswith("palcas_sumo_bridge")]
         if lost:
             console.error("training lost node(s) %s; last error: %s"
                           % (", ".join(lost), launch.last_fatal(console_text)))
