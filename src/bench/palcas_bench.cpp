@@ -11,6 +11,11 @@
 //   act_after_update_ms {"100"}: act() for 100 CAVs right after an update (includes
 //     re-folding both networks' batch norms, see FoldedNetwork), p50 over 10 x reps calls;
 //   fedavg_ms {"3","30","300"}: fedAverage of that many paper-size models;
+//   grad_step_gflop: the multiply-adds of one update counted from the layer sizes (x 2 flops);
+//   gemm_gflops_1thread: Eigen's rate on the network's largest product (512 x 256 times
+//     256 x batch), one thread; grad_step_floor_ms = grad_step_gflop / that rate, the time the
+//     update's own arithmetic needs on this core at best (what a faster kernel cannot beat
+//     without doing less arithmetic or lower precision);
 //   load_average_start/end: /proc/loadavg 1-minute load when the run started / ended.
 // Google Benchmark runs the repetitions, times the fixed iteration counts and takes the
 // medians; percentiles over single calls are no figure of its own, so those benchmarks time
@@ -33,6 +38,7 @@
 #include <unistd.h>
 
 #include "palcas_core/learning/fedavg.h"
+#include "palcas_core/learning/nn/linear.h"
 #include "palcas_core/learning/pdqn_agent.h"
 
 using namespace palcas;
@@ -127,6 +133,33 @@ const char* blasBackend() {
 #endif
 }
 
+// Multiply-adds per sample of a dense network's forward pass: sum of in x out over its layers.
+double denseMacs(int in, const std::vector<int>& hidden, int out) {
+  double macs = 0;
+  for (int width : hidden) {
+    macs += static_cast<double>(in) * width;
+    in = width;
+  }
+  return macs + static_cast<double>(in) * out;
+}
+
+// Flops of one PdqnAgent::update() without multi-pass, counted as its products run (see
+// updateQ / updateParam): the targets' forward passes (mu', Q'); Q's forward, weight and
+// input gradients (no gradient into the state rows of its first layer); mu's forward, Q's
+// forward and its input gradient back to c (Q frozen), mu's weight gradients and its input
+// gradients below the first layer. Element-wise work (batch norm, dropout, Adam) is left out.
+double gradStepGflop(const PdqnConfig& c) {
+  const int s = c.state_size;
+  const double mu = denseMacs(s, c.hidden_sizes, ACTION_PARAM_SIZE);
+  const double q = denseMacs(s + ACTION_PARAM_SIZE, c.hidden_sizes, ACTION_COUNT);
+  const double first = static_cast<double>(c.hidden_sizes.front());
+  const double q_first = (s + ACTION_PARAM_SIZE) * first, mu_first = s * first;
+  const double targets = mu + q;
+  const double update_q = q + q + (q - q_first);
+  const double update_param = mu + q + (q - q_first + ACTION_PARAM_SIZE * first) + mu + (mu - mu_first);
+  return 2.0 * c.batch_size * (targets + update_q + update_param) * 1e-9;
+}
+
 // The benchmarks, in the order they run (registration order); all share one agent, as the
 // figures always did (the decision timings run on an agent that has been updated).
 void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
@@ -141,6 +174,18 @@ void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
         })
         ->Iterations(20);  // a repetition's figure: the mean over 20 updates
   }
+  // Eigen's float product at the network's largest layer (512 x 256) times a batch, one thread.
+  benchmark::RegisterBenchmark("gemm_largest_layer", [&agent](benchmark::State& state) {
+    Rng rng(8);
+    const int widest = *std::max_element(agent.config().hidden_sizes.begin(), agent.config().hidden_sizes.end());
+    // Through the library's own Linear layer (its product is Eigen's GEMM; the bias add is
+    // 1/256 of the work), which also keeps Eigen's products out of this file.
+    nn::Linear layer(256, widest, rng);
+    const nn::Matrix batch = randomStates(256, agent.config().batch_size, rng);
+    Eigen::setNbThreads(1);
+    for (auto _ : state) benchmark::DoNotOptimize(layer.forward(batch, false).data());
+    state.counters["gflop"] = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
+  })->Iterations(200);
   for (int cavs : CAV_COUNTS) {
     benchmark::RegisterBenchmark(
         ("act/cavs:" + std::to_string(cavs)).c_str(),
@@ -206,6 +251,9 @@ class Collector : public benchmark::ConsoleReporter {
   Timing time(const std::string& name) const {
     const Run& run = medians_.at(name);
     return {run.GetAdjustedCPUTime(), run.GetAdjustedRealTime()};
+  }
+  double value(const std::string& name, const std::string& counter) const {
+    return medians_.at(name).counters.at(counter);
   }
   Timing counters(const std::string& name, const std::string& prefix) const {
     const Run& run = medians_.at(name);
@@ -285,6 +333,10 @@ int main(int argc, char** argv) {
     wall_p99[cavs] = median_p99.wall_ms;
   }
   const Timing after_update = collector.counters("act_after_update/cavs:100", "p50");
+  const double step_gflop = gradStepGflop(config);
+  const double gemm_gflops = collector.value("gemm_largest_layer", "gflop") / (collector.time("gemm_largest_layer").cpu_ms * 1e-3);
+  const double step_gflops = step_gflop / (grad_1.cpu_ms * 1e-3);
+  const double floor_ms = step_gflop / gemm_gflops * 1e3;
   for (int count : MODEL_COUNTS) {
     const Timing t = collector.time("fedavg/models:" + std::to_string(count));
     fed_cpu[count] = t.cpu_ms;
@@ -308,6 +360,9 @@ int main(int argc, char** argv) {
   printRow("act() 100 CAVs right after update(), p50", after_update.cpu_ms, after_update.wall_ms);
   for (int count : MODEL_COUNTS)
     printRow("FedAvg of " + std::to_string(count) + " models", fed_cpu[count], fed_wall[count]);
+  std::printf("gradient step arithmetic: %.3f GFLOP at %.1f GFLOP/s; Eigen's product of the widest layer"
+              " runs %.1f GFLOP/s, so the same arithmetic needs >= %.2f ms here (%.0f %% of the step)\n",
+              step_gflop, step_gflops, gemm_gflops, floor_ms, 100.0 * floor_ms / grad_1.cpu_ms);
 
   const std::filesystem::path path(out_path);
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
@@ -333,7 +388,11 @@ int main(int argc, char** argv) {
       << "  \"act_after_update_ms\": {\"100\": " << after_update.cpu_ms << "},\n"
       << "  \"act_after_update_wall_ms\": {\"100\": " << after_update.wall_ms << "},\n"
       << "  \"fedavg_ms\": " << jsonObject(fed_cpu) << ",\n"
-      << "  \"fedavg_wall_ms\": " << jsonObject(fed_wall) << "\n}\n";
+      << "  \"fedavg_wall_ms\": " << jsonObject(fed_wall) << ",\n"
+      << "  \"grad_step_gflop\": " << step_gflop << ",\n"
+      << "  \"grad_step_gflops_1thread\": " << step_gflops << ",\n"
+      << "  \"gemm_gflops_1thread\": " << gemm_gflops << ",\n"
+      << "  \"grad_step_floor_ms\": " << floor_ms << "\n}\n";
   if (!out) {
     std::fprintf(stderr, "palcas_bench: cannot write %s\n", out_path.c_str());
     return 1;
