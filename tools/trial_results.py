@@ -546,7 +546,8 @@ def what_was_run(rows, files, settings, folder, a):
                 for s in seeds_for(settings, c, seeds)]
     have = {(r["arm"], (r["demand"], r["pr"]), r["seed"]): r for r in rows}
     done = sum(1 for k in expected if k in have and have[k]["status"] == "done")
-    extra = in_grid(rows, settings, load_registry())[1]
+    fed_arms = federation_arms(settings)
+    extra = [r for r in in_grid(rows, settings, load_registry())[1] if r["arm"] not in fed_arms]
     per_cell = "their seeds" if settings.get("seeds_by_demand") else f"{len(seeds)} seeds"
     lines.append(f"- Points: {len(expected)} planned ({len(arms)} arms × {len(a['cells'])} cells × "
                  f"{per_cell}), {done} finished")
@@ -560,6 +561,12 @@ def what_was_run(rows, files, settings, folder, a):
             bad.append(f"`{arm}` {cell_short(cell)} s{seed}: {r['status']}" + (f" ({err})" if err else ""))
     lines.append("- Failed or missing points: " + ("none" if not bad else str(len(bad))))
     lines += [f"  - {b}" for b in bad]
+    fed_rows = [r for r in rows if r["arm"] in fed_arms]
+    if fed_rows:
+        lines.append(f"- The federation table: {len(fed_rows)} rows of "
+                     + ", ".join(f"`{x}`" for x in sort_arms({r['arm'] for r in fed_rows}, load_registry()))
+                     + f" ({sum(1 for r in fed_rows if r['status'] == 'done')} finished), against "
+                     f"`{federation_reference(settings)}`'s own points")
     if extra:
         lines.append(f"- Rows outside the planned grid, not in the tables: "
                      + ", ".join(f"{r.get('point') or r['arm']}" for r in extra))
@@ -679,6 +686,99 @@ def paired_section(a):
     lines += ["", "Against a control that is not the cell's best, only speed is shown here; every metric "
               "of every pair is in `results/paired.csv`."]
     return lines
+
+
+def federation_arms(settings):
+    """{arm: what it is} of trial.json's federation table (the same training budget as its
+    reference, by default `palcas`); {} without one."""
+    return dict((settings.get("federation") or {}).get("arms") or {})
+
+
+def federation_reference(settings):
+    return (settings.get("federation") or {}).get("reference") or "palcas"
+
+
+FEDERATION_METRICS = ["dsr", "lane_changes_per_cav", "throughput_vph", "total_time_spent_veh_h"]
+
+
+def analyse_federation(rows, settings, a):
+    """The reference (the shipped federation) against each arm of the federation table, per
+    cell where that arm has rows, paired by seed; and each of them against the cell's best
+    control on speed."""
+    arms, ref = federation_arms(settings), federation_reference(settings)
+    if not arms:
+        return []
+    best = {x["cell"]: x["best"] for x in a["cells"]}
+    out = []
+    for cell in cells_of([r for r in rows if r["arm"] in arms]):
+        entries = []
+        for arm in sort_arms(arms, load_registry()):
+            if not done_rows(rows, arm, cell):
+                continue
+            e = {"arm": arm, "what": arms[arm], "own": arm_cell(rows, arm, cell),
+                 "ratio": compare(rows, ref, arm, cell, SPEED, ratio=True),
+                 "metrics": [compare(rows, ref, arm, cell, m) for m in FEDERATION_METRICS]}
+            if best.get(cell):
+                e["vs_best"] = compare(rows, arm, best[cell], cell, SPEED, ratio=True)
+            entries.append(e)
+        out.append({"cell": cell, "reference": ref, "reference_own": arm_cell(rows, ref, cell),
+                    "best": best.get(cell), "entries": entries})
+    return out
+
+
+def federation_section(fed):
+    if not fed:
+        return []
+    ref = fed[0]["reference"]
+    lines = ["", "## The federation against its alternatives, same training budget", "",
+             f"`{ref}` (the shipped federation: each RSU its own final model, trained through FedAvg) "
+             "against policies trained with the same budget (episodes, durations, demand and PR draws, "
+             "actuation) but another scheme, on the same seeds, paired as above: "
+             f"`{ref}` − the other, and speed as `{ref}` ÷ the other − 1. Each is also paired with the "
+             "cell's best control on speed (that arm ÷ best control − 1)."]
+    for x in fed:
+        lines += ["", f"### {cell_title(x['cell'])}", ""]
+        for e in x["entries"]:
+            lines.append(f"- `{e['arm']}`: {e['what']}")
+        own = [[f"`{ref}`"] + federation_own_cells(x["reference_own"])]
+        own += [[f"`{e['arm']}`"] + federation_own_cells(e["own"]) for e in x["entries"]]
+        lines += ["", *md_table(["arm", "seeds", "speed m/s (95 %)", "worst seed", "DSR % (95 %)"], own)]
+        body = []
+        for e in x["entries"]:
+            name = f"`{ref}` vs `{e['arm']}`"
+            body.append([name, "speed ratio − 1"] + diff_text(e["ratio"], 2))
+            for c in e["metrics"]:
+                body.append([name, SHORT[c["metric"]] + (" †" if c["fallback"] else "")]
+                            + diff_text(c, digits_of(c["metric"])))
+            if "vs_best" in e:
+                body.append([f"`{e['arm']}` vs `{x['best']}` (best control)", "speed ratio − 1"]
+                            + diff_text(e["vs_best"], 2))
+        lines += [""] + md_table(PAIR_HEAD, body)
+    return lines
+
+
+def federation_own_cells(own):
+    m, d = own["metrics"].get(SPEED), own["metrics"].get("dsr") or {}
+    if not m:
+        return [str(own["n"]), "n/a", "n/a", "n/a"]
+    dsr = (f"{fmt(d['mean'], 1)} {interval(d['lo'], d['hi'], 1)}" if d else "n/a")
+    return [str(own["n"]), f"{fmt(m['mean'], 2)} {interval(m['lo'], m['hi'], 2)}",
+            f"{fmt(m['worst'], 2)} (s{m['worst_seed']})", dsr]
+
+
+def federation_csv(fed):
+    rows = []
+    for x in fed:
+        d, pr = x["cell"]
+        for e in x["entries"]:
+            for c in [e["ratio"]] + e["metrics"] + ([e["vs_best"]] if "vs_best" in e else []):
+                lo, hi = span(c) if c["n"] >= 2 and math.isfinite(c.get("t_lo", float("nan"))) else ("", "")
+                rows.append([d, pr, c["learned"], c["control"], c["metric"] + (" ratio %" if c["ratio"] else ""),
+                             c["n"], c.get("mean", ""), c.get("b_lo", ""), c.get("b_hi", ""), c.get("t_lo", ""),
+                             c.get("t_hi", ""), c.get("worst", ""), c.get("worst_seed", ""),
+                             verdict(c) if c["n"] else ""])
+    return csv_text(["demand", "pr", "arm", "against", "metric", "seeds", "mean_difference", "bootstrap_lo",
+                     "bootstrap_hi", "t_lo", "t_hi", "worst", "worst_seed", "reading"], rows)
 
 
 def reading_line(c, pct=False):
@@ -897,6 +997,8 @@ def generate(folder, out_dir):
     page += mechanism_section(a, registry, settings)
     page += per_cell_section(a)
     page += paired_section(a)
+    fed = analyse_federation(rows, settings, a)
+    page += federation_section(fed)
     page += reading_section(a)
     page += ["", "## Figures", ""]
     for name, _, what in FIGURES:
@@ -906,6 +1008,8 @@ def generate(folder, out_dir):
     texts = {"RESULTS.md": "\n".join(page) + "\n", "results/cells.csv": cells_csv(a),
              "results/paired.csv": paired_csv(a), "results/paired_seeds.csv": paired_seeds_csv(a),
              "results/speed_ratio.csv": speed_ratio_csv(a)}
+    if fed:
+        texts["results/federation.csv"] = federation_csv(fed)
     return texts, a
 
 

@@ -215,6 +215,46 @@ class OwnDemandTest(unittest.TestCase):
         self.assertIn("- Seeds at the printed scenario: 1 planned, 1001", lines)
 
 
+class FederationTest(unittest.TestCase):
+    """trial.json's federation table: the reference (palcas) paired with arms trained with the
+    same budget under another scheme, which are neither missing points nor 'outside the grid'."""
+
+    def setUp(self):
+        self.settings = json.loads((FIXTURE / "trial.json").read_text())
+        self.settings["federation"] = {"arms": {"independent": "no federation, same budget"}}
+        self.rows = fixture_rows()
+        for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            other = dict(r, arm="independent", point=r["point"].replace("palcas", "independent"))
+            other[SPEED] = str(float(r[SPEED]) - 1.0 - 0.1 * (r["seed"] - 1001))
+            for column in ("dsr_pct", "dsr_censored_pct"):
+                if r.get(column):
+                    other[column] = str(float(r[column]) - 5.0)
+            self.rows.append(other)
+
+    def test_the_reference_is_paired_with_each_arm_by_seed(self):
+        a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+        fed = trial_results.analyse_federation(self.rows, self.settings, a)
+        self.assertEqual([x["cell"] for x in fed], [LOW], "only where the arm has rows")
+        e = fed[0]["entries"][0]
+        self.assertEqual((e["arm"], e["ratio"]["learned"], e["ratio"]["control"]), ("independent", "palcas", "independent"))
+        speed = [c for c in e["metrics"] if c["metric"] == "dsr"][0]
+        self.assertAlmostEqual(speed["mean"], 5.0)
+        self.assertEqual(trial_results.verdict(e["ratio"]), "gain", "palcas faster on every seed")
+        self.assertEqual(e["vs_best"]["control"], [x for x in a["cells"] if x["cell"] == LOW][0]["best"])
+        page = "\n".join(trial_results.federation_section(fed))
+        self.assertIn("## The federation against its alternatives, same training budget", page)
+        self.assertIn("- `independent`: no federation, same budget", page)
+        self.assertIn("| `palcas` vs `independent` | DSR", page)
+
+    def test_its_rows_are_counted_not_listed_as_outside_the_grid(self):
+        a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+        lines = trial_results.what_was_run(self.rows, [FIXTURE / "results.csv"], self.settings, FIXTURE, a)
+        self.assertIn("- The federation table: 3 rows of `independent` (3 finished), against `palcas`'s own points", lines)
+        self.assertFalse([l for l in lines if "outside the planned grid" in l and "independent" in l])
+        self.assertEqual(trial_results.analyse_federation(self.rows, json.loads((FIXTURE / "trial.json").read_text()), a),
+                         [], "no federation table without trial.json's federation")
+
+
 class MechanismTest(unittest.TestCase):
     def test_the_real_registry(self):
         import yaml
