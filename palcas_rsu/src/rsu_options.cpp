@@ -41,6 +41,12 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   r.advise_merge = p.get<bool>("rules/advise_merge", r.advise_merge);
   c.rule_residual = p.get<bool>("rsu/rule_residual", c.rule_residual);
   c.residual_margin = p.number("rsu/residual_margin", c.residual_margin, 0.0, 1e9);
+  const std::string residual_default = p.get<std::string>("rsu/residual_default", "rule");
+  if (residual_default == "keep")
+    c.residual_default = ResidualDefault::kKeep;
+  else if (residual_default != "rule")
+    throw std::invalid_argument("parameter '" + p.fullName("rsu/residual_default") + "' is '" + residual_default +
+                                "', not one of rule, keep");
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);

@@ -125,6 +125,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "rules/exit_margin_m");
   expectRefused("head", [](ros::NodeHandle& nh) { nh.setParam("rsu/personal_head_layers", -1); },
                 "rsu/personal_head_layers");
+  expectRefused("residual", [](ros::NodeHandle& nh) { nh.setParam("rsu/residual_default", std::string("none")); },
+                "'none', not one of rule, keep");
 }
 
 int main(int argc, char** argv) {

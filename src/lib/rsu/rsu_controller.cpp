@@ -279,7 +279,8 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
-  const bool rule_first = options_.advice_source == AdviceSource::kRules || options_.rule_residual;
+  const bool rule_first = options_.advice_source == AdviceSource::kRules ||
+                          (options_.rule_residual && options_.residual_default == ResidualDefault::kRule);
   if (given) {
     decisions = *given;  // from outside (adviseWith): neither the rule nor the network is asked
   } else {
@@ -287,13 +288,15 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
       decisions.reserve(obs.member_vehicles.size());
       for (const VehicleSnapshot* v : obs.member_vehicles)
         decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
+    } else if (options_.rule_residual) {
+      decisions.assign(obs.member_vehicles.size(), Decision{Action::kKeep, 0.0f});
     }
     if (options_.rule_residual && !obs.member_ids.empty()) {
       std::vector<Decision> rule;
       rule.swap(decisions);
       agent_.actOverDefaults(obs.member_states, options_.train, rule, static_cast<float>(options_.residual_margin),
                              decisions);
-    } else if (!rule_first && !obs.member_ids.empty()) {
+    } else if (!rule_first && !options_.rule_residual && !obs.member_ids.empty()) {
       agent_.act(obs.member_states, options_.train, decisions);
     }
   }

@@ -34,6 +34,9 @@ enum class AdviceSource {
   kRules,    ///< the documented rule of rule_advisor.h (the `rules` control arm; never learns)
 };
 
+/// The advice a rule_residual network departs from (RsuControllerOptions::residual_default).
+enum class ResidualDefault { kRule, kKeep };
+
 /// Every knob of one RSU controller (config/rsu.yaml, config/reward.yaml, config/learning.yaml).
 struct RsuControllerOptions {
   std::string rsu_id = "rsu_0";  ///< non-empty; names this RSU in checkpoints and messages
@@ -51,6 +54,10 @@ struct RsuControllerOptions {
   /// units), so the policy starts from the rule and learns where to depart from it.
   bool rule_residual = false;
   double residual_margin = 0.0;
+  /// What the network departs from with rule_residual: kRule, the rule's advice; kKeep, KEEP
+  /// for every member (in assist mode: no advice, the CAV's own driving), so the network
+  /// speaks only where it is sure that advice beats none.
+  ResidualDefault residual_default = ResidualDefault::kRule;
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;
