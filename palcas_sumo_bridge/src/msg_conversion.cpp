@@ -26,7 +26,7 @@ palcas_msgs::VehicleState toMsg(const sim::VehicleRecord& r) {
   s.route_kind = static_cast<uint8_t>(r.route_kind);
   s.entry_cluster = static_cast<int8_t>(r.entry_cluster);
   s.exit_cluster = static_cast<int8_t>(r.exit_cluster);
-  s.driving_itself = r.guard.handed_back;
+  s.driving_itself = sim::AdviceGuard::drivesItself(r.guard);
   return s;
 }
 

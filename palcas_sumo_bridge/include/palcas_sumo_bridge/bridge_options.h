@@ -30,6 +30,7 @@ void forEachGuardKey(GuardOptionsT& g, F&& f) {
   f("guard_busy_at_start", g.busy_at_start);
   f("guard_busy_floor_speed_share", g.busy_floor_speed_share, 0.0, 1.0);
   f("guard_busy_handback", g.busy_handback);
+  f("guard_busy_assist_advice", g.busy_assist_advice);
   f("guard_busy_lc_assertive", g.busy_lc_assertive, 0.0, 100.0);
   f("guard_busy_change_max_accel_mps2", g.busy_change_max_accel_mps2, 0.0, 20.0);
   f("guard_busy_change_hold_s", g.busy_change_hold_s, 0.0, 600.0);

@@ -43,7 +43,7 @@ void SumoSession::updateHandback(VehicleRecord& v) {
   if (change == HandbackChange::kNone) return;
   const bool hand_back = change == HandbackChange::kHandBack;
   if (options_.assist_mode) {  // it drives itself already: only its advice is dropped
-    guard_.recordHandback(v.guard, hand_back);
+    guard_.recordHandback(v.guard, hand_back, true);
     setBusyGapAcceptance(v, hand_back);
     return;
   }

@@ -54,7 +54,7 @@ double AdviceGuard::floorMps(const GuardCav& cav, double share) {
 }
 
 AdviceVerdict AdviceGuard::judgeAdvice(const AdviceCase& advice, const GuardMemory& memory) {
-  if (memory.handed_back) {
+  if (drivesItself(memory)) {
     ++counters_.handback_advice_dropped;
     return AdviceVerdict::kDropHandedBack;
   }
@@ -119,8 +119,9 @@ HandbackChange AdviceGuard::handbackChange(bool wants, const GuardMemory& memory
   return wants ? HandbackChange::kHandBack : HandbackChange::kTakeBack;
 }
 
-void AdviceGuard::recordHandback(GuardMemory& memory, bool handed_back) {
+void AdviceGuard::recordHandback(GuardMemory& memory, bool handed_back, bool assist_mode) {
   memory.handed_back = handed_back;
+  memory.advice_kept = handed_back && assist_mode && options_.busy_assist_advice;
   if (handed_back) ++counters_.handbacks;
 }
 

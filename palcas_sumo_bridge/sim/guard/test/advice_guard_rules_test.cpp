@@ -250,6 +250,28 @@ TEST(GuardAdvice, AHandedBackCavsAdviceIsDropped) {
   EXPECT_EQ(g.counters().lane_changes_advised, 0u);
 }
 
+TEST(GuardAdvice, InAssistModeABusyZoneCanKeepItsAdvice) {
+  GuardOptions keep_advice;
+  keep_advice.busy_assist_advice = true;
+  AdviceGuard g{keep_advice};
+  AdviceCase accelerate;
+  GuardMemory assist, advisory;
+  g.recordHandback(assist, true, true);
+  g.recordHandback(advisory, true, false);
+  EXPECT_TRUE(assist.handed_back);  // still counted as handed back: its gaps and change bound
+  EXPECT_FALSE(AdviceGuard::drivesItself(assist));
+  EXPECT_TRUE(AdviceGuard::drivesItself(advisory));  // advisory mode: the hand-back as ever
+  EXPECT_EQ(g.judgeAdvice(accelerate, assist), AdviceVerdict::kCarryOut);
+  EXPECT_EQ(g.judgeAdvice(accelerate, advisory), AdviceVerdict::kDropHandedBack);
+  g.recordHandback(assist, false, true);
+  EXPECT_FALSE(assist.advice_kept);
+  AdviceGuard plain{GuardOptions{}};  // off (the default): dropped in assist mode too
+  GuardMemory m;
+  plain.recordHandback(m, true, true);
+  EXPECT_TRUE(AdviceGuard::drivesItself(m));
+  EXPECT_EQ(plain.judgeAdvice(accelerate, m), AdviceVerdict::kDropHandedBack);
+}
+
 TEST(GuardAdvice, SpeedAdviceIsCarriedOutAndNotCountedAsAChange) {
   AdviceGuard g = withBusyZone0();
   AdviceCase accelerate;

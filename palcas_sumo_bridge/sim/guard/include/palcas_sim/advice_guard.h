@@ -23,6 +23,7 @@ struct GuardOptions {
   bool busy_at_start = false;
   double busy_floor_speed_share = 1.0;
   bool busy_handback = true;
+  bool busy_assist_advice = false;  ///< assist mode: a busy zone's CAVs keep their advice
   double busy_lc_assertive = 2.0;
   double busy_change_max_accel_mps2 = 1.47;
   double busy_change_hold_s = 4.0;
@@ -58,6 +59,7 @@ struct GuardCounters {
 /// What the guard remembers of one CAV from step to step.
 struct GuardMemory {
   bool handed_back = false;            ///< busy zone: its own route-aware driving, advice dropped
+  bool advice_kept = false;            ///< handed back in assist mode with busy_assist_advice: advised still
   double last_lane_change_s = -1e18;   ///< when its last advised change was made (cooldown)
   double busy_change_until_s = -1e18;  ///< end of the busy zones' change bound
   bool busy_change_bounded = false;    ///< that bound is in force
@@ -154,8 +156,12 @@ class AdviceGuard {
   bool wantsHandback(const GuardCav& cav, bool merge_mode, bool on_road, bool mainline_or_accel_lane) const;
   /// What to carry out for a CAV that `wants` to be handed back, given its memory.
   static HandbackChange handbackChange(bool wants, const GuardMemory& memory);
-  /// The hand-back (or taking back) was carried out (counted).
-  void recordHandback(GuardMemory& memory, bool handed_back);
+  /// The hand-back (or taking back) was carried out (counted). In assist mode with
+  /// busy_assist_advice the CAV keeps its advice (advice_kept): it still gets the busy zone's
+  /// gap acceptance and change bound, and the RSU still advises it.
+  void recordHandback(GuardMemory& memory, bool handed_back, bool assist_mode = false);
+  /// It drives itself and is not advised: handed back, its advice not kept.
+  static bool drivesItself(const GuardMemory& memory) { return memory.handed_back && !memory.advice_kept; }
   /// lcAssertive for a CAV making its own changes in a busy zone; 0 = leave its own.
   double busyLcAssertive() const { return options_.enabled ? options_.busy_lc_assertive : 0.0; }
   /// The busy zones' change bound [m/s^2] for this step: from when a handed-back CAV moves
