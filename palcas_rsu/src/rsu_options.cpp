@@ -13,6 +13,21 @@
 
 namespace palcas::rsu {
 
+namespace {
+
+// A string parameter that must be one of two words: true for `second`, false for `first`
+// (the default); anything else is refused naming the key, the value and both words.
+bool secondOf(palcas::common::ParamReader& p, const char* key, const std::string& first,
+              const std::string& second) {
+  const std::string value = p.get<std::string>(key, first);
+  if (value != first && value != second)
+    throw std::invalid_argument("parameter '" + p.fullName(key) + "' is '" + value + "', not one of " + first +
+                                ", " + second);
+  return value == second;
+}
+
+}  // namespace
+
 RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::ParamDefaults* defaults) {
   palcas::common::ParamReader p(private_nh, defaults);
   RsuNodeOptions o;
@@ -28,12 +43,7 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   if (!o.zones_m.empty()) applyZones(o, p.fullName("zones_m"));
   c.num_lanes = p.integer("rsu/num_lanes", 0, 0, 100);  // 0 = the bridge's road
   c.train = p.get<bool>("rsu/train", c.train);
-  const std::string advice = p.get<std::string>("rsu/advice", "network");
-  if (advice == "rules")
-    c.advice_source = AdviceSource::kRules;
-  else if (advice != "network")
-    throw std::invalid_argument("parameter '" + p.fullName("rsu/advice") + "' is '" + advice +
-                                "', not one of network, rules");
+  if (secondOf(p, "rsu/advice", "network", "rules")) c.advice_source = AdviceSource::kRules;
   RuleAdvisorOptions& r = c.rules;
   r.exit_distance_per_lane_m = p.number("rules/exit_distance_per_lane_m", r.exit_distance_per_lane_m, 1e-3, 1e6);
   r.exit_margin_m = p.number("rules/exit_margin_m", r.exit_margin_m, 0.0, 1e6);
@@ -41,12 +51,7 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   r.advise_merge = p.get<bool>("rules/advise_merge", r.advise_merge);
   c.rule_residual = p.get<bool>("rsu/rule_residual", c.rule_residual);
   c.residual_margin = p.number("rsu/residual_margin", c.residual_margin, 0.0, 1e9);
-  const std::string residual_default = p.get<std::string>("rsu/residual_default", "rule");
-  if (residual_default == "keep")
-    c.residual_default = ResidualDefault::kKeep;
-  else if (residual_default != "rule")
-    throw std::invalid_argument("parameter '" + p.fullName("rsu/residual_default") + "' is '" + residual_default +
-                                "', not one of rule, keep");
+  if (secondOf(p, "rsu/residual_default", "rule", "keep")) c.residual_default = ResidualDefault::kKeep;
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);
   c.federation_interval_steps = p.count("rsu/federation_interval_steps", c.federation_interval_steps, 0);

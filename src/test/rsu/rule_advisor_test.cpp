@@ -162,18 +162,25 @@ TEST(RuleAdvisor, RsuControllerRefusesToTrainARuleAndBadRuleOptions) {
                                                         "rules: RuleAdvisorOptions: exit_distance_per_lane_m");
 }
 
-TEST(RuleAdvisor, ARuleResidualNetworkAdvisesTheRuleUntilDepartingPaysByTheMargin) {
+namespace {
+
+// The actions an RSU with options `o` advises the five CAVs of one zone (a fresh controller).
+std::vector<Action> residualActions(const RsuControllerOptions& o) {
   RoadSnapshot road;
   road.num_lanes = LANES;
   road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0),
                    cav("through_lane1", 1, 400.0), onAccelLane("merging", 200.0), cav("through_lane3", 3, 600.0)};
-  const auto actions = [&](RsuControllerOptions o) {
-    RsuController rsu(o);
-    std::vector<Action> out;
-    for (const auto& a : rsu.advise(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{}).advisories)
-      out.push_back(a.decision.action);
-    return out;
-  };
+  RsuController rsu(o);
+  std::vector<Action> out;
+  for (const auto& a : rsu.advise(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{}).advisories)
+    out.push_back(a.decision.action);
+  return out;
+}
+
+}  // namespace
+
+TEST(RuleAdvisor, ARuleResidualNetworkAdvisesTheRuleUntilDepartingPaysByTheMargin) {
+  const auto& actions = residualActions;
   const std::vector<Action> rule = actions(ruleController());
   RsuControllerOptions network = ruleController();
   network.advice_source = AdviceSource::kNetwork;
@@ -194,17 +201,7 @@ TEST(RuleAdvisor, ARuleResidualNetworkAdvisesTheRuleUntilDepartingPaysByTheMargi
 }
 
 TEST(RuleAdvisor, AResidualOnKeepAdvisesKeepUntilDepartingPaysByTheMargin) {
-  RoadSnapshot road;
-  road.num_lanes = LANES;
-  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0),
-                   cav("through_lane1", 1, 400.0), onAccelLane("merging", 200.0), cav("through_lane3", 3, 600.0)};
-  const auto actions = [&](RsuControllerOptions o) {
-    RsuController rsu(o);
-    std::vector<Action> out;
-    for (const auto& a : rsu.advise(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{}).advisories)
-      out.push_back(a.decision.action);
-    return out;
-  };
+  const auto& actions = residualActions;
   RsuControllerOptions network = ruleController();
   network.advice_source = AdviceSource::kNetwork;
   const std::vector<Action> alone = actions(network);
