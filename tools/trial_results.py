@@ -547,7 +547,7 @@ def what_was_run(rows, files, settings, folder, a):
     have = {(r["arm"], (r["demand"], r["pr"]), r["seed"]): r for r in rows}
     done = sum(1 for k in expected if k in have and have[k]["status"] == "done")
     fed_arms = federation_arms(settings)
-    extra = [r for r in in_grid(rows, settings, load_registry())[1] if r["arm"] not in fed_arms]
+    extra = [r for r in in_grid(rows, settings, load_registry())[1] if r["arm"] not in extra_arms(settings)]
     per_cell = "their seeds" if settings.get("seeds_by_demand") else f"{len(seeds)} seeds"
     lines.append(f"- Points: {len(expected)} planned ({len(arms)} arms × {len(a['cells'])} cells × "
                  f"{per_cell}), {done} finished")
@@ -567,6 +567,11 @@ def what_was_run(rows, files, settings, folder, a):
                      + ", ".join(f"`{x}`" for x in sort_arms({r['arm'] for r in fed_rows}, load_registry()))
                      + f" ({sum(1 for r in fed_rows if r['status'] == 'done')} finished), against "
                      f"`{federation_reference(settings)}`'s own points")
+    var_rows = [r for r in rows if r["arm"] in variant_arms(settings)]
+    if var_rows:
+        lines.append(f"- Variants chosen on the development seeds: {len(var_rows)} rows of "
+                     + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in var_rows}))
+                     + f" ({sum(1 for r in var_rows if r['status'] == 'done')} finished)")
     if extra:
         lines.append(f"- Rows outside the planned grid, not in the tables: "
                      + ", ".join(f"{r.get('point') or r['arm']}" for r in extra))
@@ -698,6 +703,17 @@ def federation_reference(settings):
     return (settings.get("federation") or {}).get("reference") or "palcas"
 
 
+def variant_arms(settings):
+    """{arm: {"base": arm, "what": text}} of trial.json's variants: a learned arm's policy run
+    another way (settings chosen on the development seeds), its rows named by the variant."""
+    return dict(settings.get("variants") or {})
+
+
+def extra_arms(settings):
+    """Arms shown in a section of their own, not in the planned grid."""
+    return set(federation_arms(settings)) | set(variant_arms(settings))
+
+
 FEDERATION_METRICS = ["dsr", "lane_changes_per_cav", "throughput_vph", "total_time_spent_veh_h"]
 
 
@@ -713,17 +729,95 @@ def analyse_federation(rows, settings, a):
     for cell in cells_of([r for r in rows if r["arm"] in arms]):
         entries = []
         for arm in sort_arms(arms, load_registry()):
-            if not done_rows(rows, arm, cell):
-                continue
-            e = {"arm": arm, "what": arms[arm], "own": arm_cell(rows, arm, cell),
-                 "ratio": compare(rows, ref, arm, cell, SPEED, ratio=True),
-                 "metrics": [compare(rows, ref, arm, cell, m) for m in FEDERATION_METRICS]}
-            if best.get(cell):
-                e["vs_best"] = compare(rows, arm, best[cell], cell, SPEED, ratio=True)
-            entries.append(e)
+            if done_rows(rows, arm, cell):
+                entries.append(dict(paired_entry(rows, cell, ref, arm, FEDERATION_METRICS, best.get(cell)),
+                                    arm=arm, what=arms[arm]))
         out.append({"cell": cell, "reference": ref, "reference_own": arm_cell(rows, ref, cell),
                     "best": best.get(cell), "entries": entries})
     return out
+
+
+def paired_entry(rows, cell, left, right, metrics, best):
+    """`left` against `right` in one cell (speed ratio and `metrics`), paired by seed, the
+    right-hand arm's own numbers, and the arm that is not the reference against the cell's
+    best control on speed."""
+    e = {"own": arm_cell(rows, right, cell), "ratio": compare(rows, left, right, cell, SPEED, ratio=True),
+         "metrics": [compare(rows, left, right, cell, m) for m in metrics]}
+    if best:
+        e["vs_best"] = compare(rows, right, best, cell, SPEED, ratio=True)
+    return e
+
+
+def analyse_variants(rows, settings, a):
+    """Each variant against the cell's best control (every paired metric) and against its
+    base arm (speed and the metrics the base differs in), per cell where it has rows."""
+    variants = variant_arms(settings)
+    best = {x["cell"]: x["best"] for x in a["cells"]}
+    out = []
+    for cell in cells_of([r for r in rows if r["arm"] in variants]):
+        entries = []
+        for arm in sorted(variants):
+            if not done_rows(rows, arm, cell):
+                continue
+            e = {"arm": arm, "what": variants[arm].get("what", ""), "base": variants[arm].get("base", "")}
+            if best.get(cell):
+                e["vs_best"] = dict(paired_entry(rows, cell, arm, best[cell], PAIRED, None), control=best[cell])
+            if e["base"] and done_rows(rows, e["base"], cell):
+                e["vs_base"] = paired_entry(rows, cell, arm, e["base"], FEDERATION_METRICS, None)
+            e["own"] = arm_cell(rows, arm, cell)
+            entries.append(e)
+        out.append({"cell": cell, "best": best.get(cell), "entries": entries})
+    return out
+
+
+def variants_section(var):
+    if not var:
+        return []
+    lines = ["", "## Learned variants chosen on the development seeds", "",
+             "A learned arm's policy run another way, its setting chosen on the development seeds "
+             "before any test seed, then run on the test seeds: paired with the cell's best control "
+             "(every metric, as above) and with the arm it varies (variant − that arm)."]
+    for x in var:
+        lines += ["", f"### {cell_title(x['cell'])}", ""]
+        body = []
+        for e in x["entries"]:
+            lines.append(f"- `{e['arm']}`: {e['what']}")
+            for key, against in (("vs_best", e.get("vs_best", {}).get("control")), ("vs_base", e["base"])):
+                if key not in e:
+                    continue
+                name = f"`{e['arm']}` vs `{against}`" + (" (best control)" if key == "vs_best" else "")
+                body.append([name, "speed ratio − 1"] + diff_text(e[key]["ratio"], 2))
+                for c in e[key]["metrics"]:
+                    if c["metric"] != SPEED:
+                        body.append([name, SHORT[c["metric"]] + (" †" if c["fallback"] else "")]
+                                    + diff_text(c, digits_of(c["metric"])))
+            if "vs_best" in e:
+                lines.append(f"  - reading against `{e['vs_best']['control']}`: "
+                             + reading_line(e["vs_best"]["ratio"], pct=True) + "; "
+                             + "; ".join(reading_line(c) for c in e["vs_best"]["metrics"] if c["metric"] != SPEED))
+        lines += [""] + md_table(PAIR_HEAD, body)
+    return lines
+
+
+def variants_csv(var):
+    rows = []
+    for x in var:
+        d, pr = x["cell"]
+        for e in x["entries"]:
+            for key in ("vs_best", "vs_base"):
+                if key in e:
+                    rows += comparison_rows(d, pr, [e[key]["ratio"]] + e[key]["metrics"])
+    return csv_text(COMPARISON_HEAD, rows)
+
+
+COMPARISON_HEAD = ["demand", "pr", "arm", "against", "metric", "seeds", "mean_difference", "bootstrap_lo",
+                   "bootstrap_hi", "t_lo", "t_hi", "worst", "worst_seed", "reading"]
+
+
+def comparison_rows(d, pr, comparisons):
+    return [[d, pr, c["learned"], c["control"], c["metric"] + (" ratio %" if c["ratio"] else ""), c["n"],
+             c.get("mean", ""), c.get("b_lo", ""), c.get("b_hi", ""), c.get("t_lo", ""), c.get("t_hi", ""),
+             c.get("worst", ""), c.get("worst_seed", ""), verdict(c) if c["n"] else ""] for c in comparisons]
 
 
 def federation_section(fed):
@@ -771,14 +865,8 @@ def federation_csv(fed):
     for x in fed:
         d, pr = x["cell"]
         for e in x["entries"]:
-            for c in [e["ratio"]] + e["metrics"] + ([e["vs_best"]] if "vs_best" in e else []):
-                lo, hi = span(c) if c["n"] >= 2 and math.isfinite(c.get("t_lo", float("nan"))) else ("", "")
-                rows.append([d, pr, c["learned"], c["control"], c["metric"] + (" ratio %" if c["ratio"] else ""),
-                             c["n"], c.get("mean", ""), c.get("b_lo", ""), c.get("b_hi", ""), c.get("t_lo", ""),
-                             c.get("t_hi", ""), c.get("worst", ""), c.get("worst_seed", ""),
-                             verdict(c) if c["n"] else ""])
-    return csv_text(["demand", "pr", "arm", "against", "metric", "seeds", "mean_difference", "bootstrap_lo",
-                     "bootstrap_hi", "t_lo", "t_hi", "worst", "worst_seed", "reading"], rows)
+            rows += comparison_rows(d, pr, [e["ratio"]] + e["metrics"] + ([e["vs_best"]] if "vs_best" in e else []))
+    return csv_text(COMPARISON_HEAD, rows)
 
 
 def reading_line(c, pct=False):
@@ -999,6 +1087,8 @@ def generate(folder, out_dir):
     page += paired_section(a)
     fed = analyse_federation(rows, settings, a)
     page += federation_section(fed)
+    var = analyse_variants(rows, settings, a)
+    page += variants_section(var)
     page += reading_section(a)
     page += ["", "## Figures", ""]
     for name, _, what in FIGURES:
@@ -1010,6 +1100,8 @@ def generate(folder, out_dir):
              "results/speed_ratio.csv": speed_ratio_csv(a)}
     if fed:
         texts["results/federation.csv"] = federation_csv(fed)
+    if var:
+        texts["results/variants.csv"] = variants_csv(var)
     return texts, a
 
 

@@ -255,6 +255,36 @@ class FederationTest(unittest.TestCase):
                          [], "no federation table without trial.json's federation")
 
 
+class VariantTest(unittest.TestCase):
+    """trial.json's variants: a learned arm run another way, paired with the best control and
+    with the arm it varies, outside the planned grid."""
+
+    def test_a_variant_is_paired_with_the_best_control_and_its_base(self):
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings["variants"] = {"palcas_margin": {"base": "palcas", "what": "palcas with a margin"}}
+        rows = fixture_rows()
+        for r in [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            rows.append(dict(r, arm="palcas_margin", point=r["point"].replace("palcas", "palcas_margin"),
+                             **{SPEED: str(float(r[SPEED]) + 0.5)}))
+        a = trial_results.analyse(rows, settings, trial_results.load_registry())
+        var = trial_results.analyse_variants(rows, settings, a)
+        self.assertEqual([x["cell"] for x in var], [LOW])
+        e = var[0]["entries"][0]
+        best = [x for x in a["cells"] if x["cell"] == LOW][0]["best"]
+        self.assertEqual(e["vs_best"]["control"], best)
+        speed = [c for c in e["vs_base"]["metrics"] if c["metric"] == "dsr"]
+        self.assertEqual(speed[0]["mean"], 0.0, "the same DSR as its base on every seed")
+        base_ratio = e["vs_base"]["ratio"]
+        self.assertEqual((base_ratio["learned"], base_ratio["control"]), ("palcas_margin", "palcas"))
+        self.assertEqual(trial_results.verdict(base_ratio), "gain")
+        page = "\n".join(trial_results.variants_section(var))
+        self.assertIn("## Learned variants chosen on the development seeds", page)
+        self.assertIn(f"| `palcas_margin` vs `{best}` (best control) | speed ratio − 1 |", page)
+        lines = trial_results.what_was_run(rows, [FIXTURE / "results.csv"], settings, FIXTURE, a)
+        self.assertIn("- Variants chosen on the development seeds: 3 rows of `palcas_margin` (3 finished)", lines)
+        self.assertFalse([l for l in lines if "outside the planned grid" in l and "palcas_margin" in l])
+
+
 class MechanismTest(unittest.TestCase):
     def test_the_real_registry(self):
         import yaml
