@@ -28,6 +28,7 @@ import experiment_results  # noqa: E402
 import palcas_stats  # noqa: E402
 import run_figures  # noqa: E402
 import seed_ratio  # noqa: E402
+import training_pace  # noqa: E402
 import ratio_by_demand  # noqa: E402
 import comfort_breakdown  # noqa: E402
 import v2x_table  # noqa: E402
@@ -727,6 +728,32 @@ class ComfortBreakdownTest(unittest.TestCase):
         with self.assertRaises(SystemExit) as e:
             comfort_breakdown.main([tempfile.gettempdir() + "/no_such_run", "--by-lane-change"])
         self.assertIn("no <arm>/trajectories.csv", str(e.exception))
+
+
+class TrainingPaceTest(unittest.TestCase):
+    """tools/training_pace.py: its variants and the real-time factors it reads from records."""
+
+    def test_bad_variants_and_values_are_refused_before_anything_runs(self):
+        for argv, words in ((["--out", "/tmp/x", "--variant", "noequals"], "NAME=RSU_PARAMS_YAML"),
+                            (["--out", "/tmp/x", "--variant", "a=no/such.yaml"], "no file no/such.yaml"),
+                            (["--out", "/tmp/x", "--variant", "a=", "--episodes", "0"], "must be positive")):
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as exit_:
+                training_pace.main(argv)
+            self.assertEqual(exit_.exception.code, 2)
+            self.assertIn(words, err.getvalue())
+        self.assertEqual(training_pace.variant("shipped="), ("shipped", ""))
+
+    def test_real_time_factors_are_simulated_over_wall_seconds_of_the_records(self):
+        folder = pathlib.Path(tempfile.mkdtemp(prefix="palcas_pace_"))
+        self.addCleanup(shutil.rmtree, folder, True)
+        (folder / "episodes.csv").write_text("episode,sim_seconds,wall_seconds\n0,900,60\n1,900,90\n")
+        self.assertEqual(training_pace.training_rtf(str(folder)), (12.0, 2))
+        for k, wall in ((1, 20.0), (2, 30.0)):
+            (folder / f"e{k}" / "sumo_native").mkdir(parents=True)
+            (folder / f"e{k}" / "sumo_native" / "metrics.json").write_text(
+                json.dumps({"sim_seconds": 900, "wall_seconds": wall}))
+        self.assertEqual(training_pace.evaluation_rtf([str(folder / "e1"), str(folder / "e2")]), 36.0)
 
 
 def main():
