@@ -279,26 +279,27 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   out.model_version = counters_.model_version;
   out.cluster = obs.cluster;
   std::vector<Decision> decisions;
-  const bool rule_first = options_.advice_source == AdviceSource::kRules ||
-                          (options_.rule_residual && options_.residual_default == ResidualDefault::kRule);
+  const auto ruleDecisions = [&] {
+    std::vector<Decision> rule;
+    rule.reserve(obs.member_vehicles.size());
+    for (const VehicleSnapshot* v : obs.member_vehicles)
+      rule.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
+    return rule;
+  };
   if (given) {
     decisions = *given;  // from outside (adviseWith): neither the rule nor the network is asked
-  } else {
-    if (rule_first) {
-      decisions.reserve(obs.member_vehicles.size());
-      for (const VehicleSnapshot* v : obs.member_vehicles)
-        decisions.push_back(ruleDecision(*v, options_.num_lanes, options_.rules));
-    } else if (options_.rule_residual) {
-      decisions.assign(obs.member_vehicles.size(), Decision{Action::kKeep, 0.0f});
-    }
-    if (options_.rule_residual && !obs.member_ids.empty()) {
-      std::vector<Decision> rule;
-      rule.swap(decisions);
-      agent_.actOverDefaults(obs.member_states, options_.train, rule, static_cast<float>(options_.residual_margin),
-                             decisions);
-    } else if (!rule_first && !options_.rule_residual && !obs.member_ids.empty()) {
-      agent_.act(obs.member_states, options_.train, decisions);
-    }
+  } else if (options_.advice_source == AdviceSource::kRules) {
+    decisions = ruleDecisions();
+  } else if (options_.rule_residual && !obs.member_ids.empty()) {
+    // The network departs from a default: the rule's advice, or KEEP for every member.
+    const std::vector<Decision> defaults =
+        options_.residual_default == ResidualDefault::kRule
+            ? ruleDecisions()
+            : std::vector<Decision>(obs.member_vehicles.size(), Decision{Action::kKeep, 0.0f});
+    agent_.actOverDefaults(obs.member_states, options_.train, defaults, static_cast<float>(options_.residual_margin),
+                           decisions);
+  } else if (!obs.member_ids.empty()) {
+    agent_.act(obs.member_states, options_.train, decisions);
   }
   for (size_t i = 0; i < decisions.size(); ++i)
     decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);
