@@ -30,6 +30,7 @@ SHIPPED_TRAINING = ["--arm", "palcas", "--explore-fraction", "0.4",
 
 def timed(command, log_path):
     """Runs command (its output to log_path); (exit status, wall seconds)."""
+    os.makedirs(os.path.dirname(log_path) or ".", exist_ok=True)
     start = time.monotonic()
     with open(log_path, "w") as log:
         status = subprocess.call(command, cwd=ROOT, stdout=log, stderr=subprocess.STDOUT)

@@ -755,6 +755,16 @@ class TrainingPaceTest(unittest.TestCase):
                 json.dumps({"sim_seconds": 900, "wall_seconds": wall}))
         self.assertEqual(training_pace.evaluation_rtf([str(folder / "e1"), str(folder / "e2")]), 36.0)
 
+    def test_a_run_log_lands_in_a_round_folder_that_did_not_exist(self):
+        # The first real run died here: the log of round 0's first run had no folder yet.
+        folder = pathlib.Path(tempfile.mkdtemp(prefix="palcas_pace_"))
+        self.addCleanup(shutil.rmtree, folder, True)
+        log = folder / "round0" / "sumo_native_s1.log"
+        status, wall = training_pace.timed([sys.executable, "-c", "print('ran')"], str(log))
+        self.assertEqual(status, 0)
+        self.assertGreaterEqual(wall, 0.0)
+        self.assertEqual(log.read_text().strip(), "ran")
+
 
 def main():
     run_as_junit(sys.modules[__name__], "experiment_tools")
