@@ -24,7 +24,7 @@ eval_point() {  # NAME [--in-process]
   PALCAS_NO_BUILD=1 timeout -k 10 900 "$ROOT/palcas" run --arm palcas --no-compare --pr 60 --demand 1400 \
     --duration 300 --seed 1001 --out "$WORK/$name" "$@" >"$WORK/$name.log" 2>&1
 }
-train_short() {  # NAME [--in-process]
+train_short() {  # NAME --rsu-nodes | --in-process
   local name="$1"; shift
   PALCAS_NO_BUILD=1 timeout -k 10 900 "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 120 --seed 7 \
     --record-decisions --bridge-params "$ROOT/config/reproducible/bridge.yaml" \
@@ -78,7 +78,7 @@ eval_point ros || why="ROS-node evaluation: exit $?: $(tail -3 "$WORK/ros.log")"
 result evaluation_gives_the_same_trajectories_advice_and_metrics_both_ways "$why"
 
 why=""
-train_short train_ros || why="ROS-node training: exit $?: $(tail -3 "$WORK/train_ros.log")"
+train_short train_ros --rsu-nodes || why="ROS-node training: exit $?: $(tail -3 "$WORK/train_ros.log")"
 [ -n "$why" ] || train_short train_inprocess --in-process ||
   why="in-process training: exit $?: $(tail -3 "$WORK/train_inprocess.log")"
 [ -n "$why" ] || why="$(compare train "$WORK/train_ros" "$WORK/train_inprocess")"

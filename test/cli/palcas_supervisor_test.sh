@@ -11,17 +11,23 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 source "$ROOT/test/junit.sh"
 junit_script palcas_supervisor "$@"
 
+# The same refusal on both paths: RSU nodes that die, and in-process RSUs (the default) that the
+# bridge refuses at start; three episodes asked, so a refusal retried per episode would show.
 printf 'rsu:\n  gradient_steps_per_decision: -1.0\n' >"$WORK/bad_rsu.yaml"
-status=0
-PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 20 \
-  --rsu-params "$WORK/bad_rsu.yaml" --out "$WORK/train" >"$WORK/out.log" 2>"$WORK/err.log" || status=$?
-why=""
-if [ "$status" -eq 0 ]; then why="exit 0 although every RSU died"
-elif ! grep -q "error: training lost node(s) rsu_0" "$WORK/err.log"; then why="no line naming rsu_0: $(cat "$WORK/err.log")"
-elif ! grep -q "gradient_steps_per_decision" "$WORK/err.log"; then why="the node's error is not named: $(cat "$WORK/err.log")"
-elif ! grep -q "run without it" "$WORK/train/aborted_episodes.txt" 2>/dev/null; then why="aborted_episodes.txt does not record the lost episodes"
-fi
-result train_fails_when_an_rsu_dies "$why"
+for path in rsu_nodes in_process; do
+  status=0
+  PALCAS_NO_BUILD=1 timeout -k 10 300 "$ROOT/palcas" train --scenario tiny --episodes 3 --duration 20 \
+    $([ "$path" = rsu_nodes ] && echo --rsu-nodes) --rsu-params "$WORK/bad_rsu.yaml" --out "$WORK/train_$path" \
+    >"$WORK/out_$path.log" 2>"$WORK/err_$path.log" || status=$?
+  why=""
+  if [ "$status" -eq 0 ]; then why="exit 0 although every RSU died"
+  elif ! grep -q "error: training lost node(s) rsu_0" "$WORK/err_$path.log"; then why="no line naming rsu_0: $(cat "$WORK/err_$path.log")"
+  elif ! grep -q "gradient_steps_per_decision" "$WORK/err_$path.log"; then why="the node's error is not named: $(cat "$WORK/err_$path.log")"
+  elif ! grep -q "run without it" "$WORK/train_$path/aborted_episodes.txt" 2>/dev/null; then why="aborted_episodes.txt does not record the lost episodes"
+  elif [ "$(grep -c "^launch " "$WORK/train_$path/aborted_episodes.txt")" != 1 ]; then why="more than one launch: $(cat "$WORK/train_$path/aborted_episodes.txt")"
+  fi
+  result "train_fails_when_an_rsu_dies_$path" "$why"
+done
 
 # RSU zones that are not the bridge's road (tiny: [0, 300, 600]): the RSUs refuse at start,
 # naming both, and the training fails instead of running zones without CAVs.

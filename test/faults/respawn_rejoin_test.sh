@@ -29,7 +29,8 @@ wait_for() {  # SECONDS COMMAND...: poll until the command succeeds
 }
 
 { cat "$ROOT/config/training/short_rsu.yaml"; printf 'checkpoint_every_decisions: 60\n'; } >"$WORK/rsu.yaml"
-PALCAS_NO_BUILD=1 "$ROOT/palcas" train --scenario tiny --episodes 1 --duration 3000 \
+# RSU nodes (--rsu-nodes): the processes this test kills; in process they would be the bridge.
+PALCAS_NO_BUILD=1 "$ROOT/palcas" train --rsu-nodes --scenario tiny --episodes 1 --duration 3000 \
   --learning "$ROOT/config/training/tiny_fast_learning.yaml" --rsu-params "$WORK/rsu.yaml" \
   --out "$OUT" >"$WORK/train.log" 2>&1 &
 train_pid=$!

@@ -322,6 +322,17 @@ class ConsoleLog(unittest.TestCase):
         self.assertEqual(launch.crash_reason("all fine"), "")
         self.assertIn("[FATAL]", launch.last_fatal("[ INFO] ok\n[FATAL] [1.0]: bad key\n"))
 
+    def test_an_in_process_rsu_refused_at_start_is_named_once(self):
+        # The bridge's FATAL for an RSU whose parameters it refused: every episode would repeat it.
+        fatal = ("\x1b[31m[FATAL] [1795843404.68]: palcas bridge: in-process RSU 'rsu_0' (parameters under "
+                 "/rsu_0/rsu): parameter '/rsu_0/rsu/rsu/gradient_steps_per_decision' = -1 is outside [0, 1000)\x1b[0m\n")
+        self.assertEqual(launch.inprocess_refusals(fatal + fatal), ["rsu_0"])
+        self.assertEqual(launch.inprocess_refusals("[FATAL] [1.0]: palcas bridge: in-process RSU 'rsu_2' not "
+                                                   "registered: taken\n"), ["rsu_2"])
+        # A SUMO abort or a warning that mentions in-process RSUs is no refusal.
+        self.assertEqual(launch.inprocess_refusals("[ INFO] palcas bridge: 3 RSU(s) in process, answering by call\n"
+                                                   "sumo: MSVehicle.cpp:1: Assertion `x' failed.\n"), [])
+
 
 class MessageKey(unittest.TestCase):
     """launch/scripts/message_key, which system.launch runs by default and ./palcas calls."""

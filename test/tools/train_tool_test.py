@@ -303,13 +303,17 @@ class Simulations(unittest.TestCase):
                            (["--simulations", "2", "--arm", "independent"], "has no federation"),
                            (["--simulations", "2", "--pr-range", "10,20"], "not with --demand-range or --pr-range"),
                            (["--simulations", "2", "--episodes", "1001"], "at most 1000 --episodes"),
-                           (["--plan"], "--plan")):
+                           (["--plan"], "--plan"),
+                           (["--in-process", "--rsu-nodes"], "give one of them"),
+                           (["--simulations", "2", "--rsu-nodes"], "--rsu-nodes: not with --simulations 2")):
             with self.subTest(argv=argv), self.assertRaisesRegex(OptionError, text):
                 train.check(argv)
 
     def test_one_simulation_is_todays_training(self):
         opts = train.check([])[0]
-        self.assertEqual((opts["simulations"], opts["inprocess"]), (1, False))
+        self.assertEqual((opts["simulations"], opts["inprocess"]), (1, True))
+        self.assertFalse(train.check(["--rsu-nodes"])[0]["inprocess"])
+        self.assertTrue(train.check(["--in-process"])[0]["inprocess"])
         out = tempfile.mkdtemp()
         record = train.write_record(out, dict(opts, learning="", rsu_params="", bridge_params=""), "abc")
         self.assertNotIn("simulations", record)

@@ -125,6 +125,13 @@ def last_fatal(console_text):
     return lines[-1][:400] if lines else ""
 
 
+def inprocess_refusals(console_text):
+    """The in-process RSUs the bridge refused at start (their parameters, or their registration),
+    sorted: a configuration error that every later episode would repeat, so a training stops on
+    it as on a lost RSU node, where a SUMO crash costs one episode."""
+    return sorted(set(re.findall(r"\[FATAL\].*?in-process RSU '([^']+)'", ANSI.sub("", console_text))))
+
+
 def crash_reason(console_text):
     """Why a simulation ended early: its own error first (an RSU killed on the way is not why)."""
     text = ANSI.sub("", console_text)

@@ -72,7 +72,8 @@ VALUES = {"--explore-fraction": "explore_fraction", "--episodes": "episodes", "-
           "--learning": "learning", "--rsu-params": "rsu_params", "--bridge-params": "bridge_params",
           "--v2x": "v2x_params", "--simulations": "simulations"}
 FLAGS = {"--paper-printed": ("paper_printed", True), "--resume": ("resume", True),
-         "--in-process": ("inprocess", True), "--record-decisions": ("record_decisions", True),
+         "--in-process": ("inprocess", True), "--rsu-nodes": ("rsu_nodes", True),
+         "--record-decisions": ("record_decisions", True),
          "--plan": ("plan", True)}
 # A new training's defaults as typed (DEFAULTS's values, 3600.0 as 3600).
 TYPED_DEFAULTS = {k: v if isinstance(v, str) else "%g" % v for k, v in DEFAULTS.items()
@@ -111,7 +112,9 @@ HELPS = {
                              "1")),
     "--in-process": (None, D("run the RSUs inside the bridge process (the RSU node's own decision code, a call "
                              "per step instead of ROS topics; federation still over the server's services)",
-                             "off: one RSU node per zone")),
+                             "on")),
+    "--rsu-nodes": (None, D("run one RSU node per zone instead, their advice over ROS topics (the deployment "
+                            "path: the same decisions, slower when the learners leave SUMO a core)", "off")),
     "--record-decisions": (None, D("record trajectories.csv and decisions.csv of every episode (every 10 steps), "
                                    "as ./palcas run does", "off")),
     "--plan": (None, D("with --simulations K: write the training record and <out>/slurm_train.sh (one Slurm job: "
@@ -437,6 +440,7 @@ def run_simulations(out, opts, record, resume, command_line):
         text = launch.read_text(console_log)
         bridge = "sim%d/palcas_sumo_bridge" % k
         deaths = [d for d in launch.node_deaths(text, crashed_by=bridge) if not d.startswith(bridge)]
+        deaths += ["%s (in process, refused at start)" % r for r in launch.inprocess_refusals(text)]
         if deaths:
             lost.append("simulation %d lost %s; last error: %s" % (k, ", ".join(deaths), launch.last_fatal(text)))
             return
@@ -626,6 +630,8 @@ def run_launches(out, opts, record, resume, command_line):
         # next launch starts it afresh (launch.node_deaths' crashed_by).
         lost = [d for d in launch.node_deaths(console_text, crashed_by="palcas_sumo_bridge")
                 if not d.startswith("palcas_sumo_bridge")]
+        # An in-process RSU the bridge refused at start would refuse again in every episode.
+        lost += ["%s (in process, refused at start)" % r for r in launch.inprocess_refusals(console_text)]
         if lost:
             console.error("training lost node(s) %s; last error: %s"
                           % (", ".join(lost), launch.last_fatal(console_text)))
@@ -691,7 +697,11 @@ def check(argv):
     if not resume:
         opts.update(overrides, paper_printed=bool(given.get("paper_printed")))
     # How it runs and what it records, not what it learns: any launch may choose.
-    opts["inprocess"] = bool(given.get("inprocess"))
+    # In process by default: the same decisions as RSU nodes (test/cli/inprocess_parity_test.sh)
+    # without a ROS round trip per step, which costs most when the learners leave SUMO a core.
+    if given.get("inprocess") and given.get("rsu_nodes"):
+        raise OptionError("--in-process and --rsu-nodes: give one of them")
+    opts["inprocess"] = not given.get("rsu_nodes")
     opts["record_decisions"] = bool(given.get("record_decisions"))
     opts["simulations"] = settle_simulations(given, record, out, opts)
     opts["plan"] = bool(given.get("plan"))
@@ -725,6 +735,9 @@ def settle_simulations(given, record, out, opts):
     if int(opts["episodes"]) > SIMULATION_SEED_STRIDE:
         raise OptionError("--simulations %d: at most %d --episodes per simulation (simulation k's episodes run "
                           "seeds seed + %d k + e)" % (count, SIMULATION_SEED_STRIDE, SIMULATION_SEED_STRIDE))
+    if given.get("rsu_nodes"):
+        raise OptionError("--rsu-nodes: not with --simulations %d (each simulation's RSUs live in its bridge, "
+                          "on its clock)" % count)
     opts["inprocess"] = True  # each simulation's RSUs live in its bridge, on its clock
     return count
 
