@@ -572,6 +572,11 @@ def what_was_run(rows, files, settings, folder, a):
         lines.append(f"- Variants chosen on the development seeds: {len(var_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in var_rows}))
                      + f" ({sum(1 for r in var_rows if r['status'] == 'done')} finished)")
+    tr_rows = [r for r in rows if r["arm"] in training_arms(settings) and r["arm"] != training_reference(settings)]
+    if tr_rows:
+        lines.append(f"- Trainings of the shipped configuration from other seeds: {len(tr_rows)} rows of "
+                     + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in tr_rows}))
+                     + f" ({sum(1 for r in tr_rows if r['status'] == 'done')} finished)")
     if extra:
         lines.append(f"- Rows outside the planned grid, not in the tables: "
                      + ", ".join(f"{r.get('point') or r['arm']}" for r in extra))
@@ -709,9 +714,20 @@ def variant_arms(settings):
     return dict(settings.get("variants") or {})
 
 
+def training_arms(settings):
+    """{arm: {"seed": training seed, "what": text}} of trial.json's trainings: the shipped
+    configuration trained again from other seeds, its reference (the shipped policy) among them."""
+    return dict((settings.get("trainings") or {}).get("arms") or {})
+
+
+def training_reference(settings):
+    return (settings.get("trainings") or {}).get("reference") or "palcas"
+
+
 def extra_arms(settings):
     """Arms shown in a section of their own, not in the planned grid."""
-    return set(federation_arms(settings)) | set(variant_arms(settings))
+    retrained = set(training_arms(settings)) - {training_reference(settings)}
+    return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained
 
 
 FEDERATION_METRICS = ["dsr", "lane_changes_per_cav", "throughput_vph", "total_time_spent_veh_h"]
@@ -768,6 +784,108 @@ def analyse_variants(rows, settings, a):
             entries.append(e)
         out.append({"cell": cell, "best": best.get(cell), "entries": entries})
     return out
+
+
+def stdev(values):
+    """The sample standard deviation (n - 1), nan for fewer than 2 values."""
+    if len(values) < 2:
+        return float("nan")
+    m = sum(values) / len(values)
+    return math.sqrt(sum((v - m) ** 2 for v in values) / (len(values) - 1))
+
+
+def analyse_trainings(rows, settings, a):
+    """Per cell where the reference and at least one retraining have rows: each training's
+    speed ratio to the cell's best control (per seed, on the seeds every training and the
+    control finished), the spread between the trainings' means against the spread between
+    traffic seeds within a training, and each retraining paired with the reference."""
+    arms, ref = training_arms(settings), training_reference(settings)
+    if not arms:
+        return []
+    best = {x["cell"]: x["best"] for x in a["cells"]}
+    order = [ref] + sorted((x for x in arms if x != ref), key=lambda x: (arms[x].get("seed", 0), x))
+    out = []
+    for cell in cells_of([r for r in rows if r["arm"] in arms and r["arm"] != ref]):
+        control = best.get(cell)
+        present = [x for x in order if done_rows(rows, x, cell)]
+        if control is None or ref not in present or len(present) < 2:
+            continue
+        by_arm = {x: {s: v for s, v, _ in pair(rows, x, control, cell, SPEED)[0]}
+                  for x in present}
+        ctrl = {s: c for s, _, c in pair(rows, ref, control, cell, SPEED)[0]}
+        common = sorted(set(ctrl).intersection(*[set(v) for v in by_arm.values()]))
+        entries = []
+        for x in present:
+            per = [(s, 100.0 * (by_arm[x][s] / ctrl[s] - 1.0)) for s in common if ctrl[s]]
+            vals = [v for _, v in per]
+            mean, lo, hi = palcas_stats.t_interval(vals) if vals else (float("nan"),) * 3
+            worst = summary(per, "higher") if per else {"worst": float("nan"), "worst_seed": ""}
+            e = {"arm": x, "seed": arms.get(x, {}).get("seed", ""), "what": arms.get(x, {}).get("what", ""),
+                 "n": len(vals), "mean": mean, "lo": lo, "hi": hi, "sd": stdev(vals),
+                 "worst": worst["worst"], "worst_seed": worst["worst_seed"]}
+            if x != ref:
+                e["vs_reference"] = compare(rows, x, ref, cell, SPEED, common, ratio=True)
+            entries.append(e)
+        means = [e["mean"] for e in entries]
+        within = math.sqrt(sum(e["sd"] ** 2 for e in entries) / len(entries)) if entries else float("nan")
+        n = len(common)
+        out.append({"cell": cell, "control": control, "reference": ref, "seeds": common, "entries": entries,
+                    "between_sd": stdev(means), "between_range": (min(means), max(means)),
+                    "mean_of_means": sum(means) / len(means), "within_sd": within,
+                    "within_se": within / math.sqrt(n) if n else float("nan")})
+    return out
+
+
+def trainings_section(tr):
+    if not tr:
+        return []
+    ref = tr[0]["reference"]
+    lines = ["", "## Variance across trainings of the shipped configuration", "",
+             f"The shipped configuration trained again from other training seeds (other traffic, demand "
+             f"and PR draws, network initialisation and exploration), each run on the same test seeds. "
+             f"Per training: speed ÷ the cell's best control − 1, per seed, then its mean over the seeds "
+             f"every training and the control finished. Between trainings: the standard deviation of "
+             f"those means; between traffic seeds: the pooled standard deviation of the per-seed values "
+             f"within a training, and the standard error it gives one training's mean. A difference "
+             f"between two trained policies smaller than the spread between trainings of one "
+             f"configuration is not a difference between their configurations."]
+    for x in tr:
+        lines += ["", f"### {cell_title(x['cell'])}, against `{x['control']}`", ""]
+        for e in x["entries"]:
+            if e["what"]:
+                lines.append(f"- `{e['arm']}` (training seed {e['seed']}): {e['what']}")
+        body = [[f"`{e['arm']}`", str(e["seed"]), str(e["n"]), fmt(e["mean"], 2, signed=True) + " %",
+                 interval(e["lo"], e["hi"], 2), fmt(e["sd"], 2), f"{fmt(e['worst'], 2, signed=True)} % (s{e['worst_seed']})"]
+                for e in x["entries"]]
+        lines += ["", *md_table(["training", "training seed", "seeds", f"speed vs `{x['control']}`",
+                                 "paired-t 95 %", "SD over seeds", "worst seed"], body)]
+        lo, hi = x["between_range"]
+        lines += ["", f"- Between trainings ({len(x['entries'])}): mean {fmt(x['mean_of_means'], 2, signed=True)} %, "
+                  f"SD {fmt(x['between_sd'], 2)} points, range {fmt(lo, 2, signed=True)} to {fmt(hi, 2, signed=True)} %",
+                  f"- Between traffic seeds within a training: SD {fmt(x['within_sd'], 2)} points; the "
+                  f"standard error of one training's mean over {len(x['seeds'])} seeds "
+                  f"{fmt(x['within_se'], 2)} points"]
+        pairs = [e for e in x["entries"] if "vs_reference" in e]
+        if pairs:
+            body = [[f"`{e['arm']}` vs `{ref}`", "speed ratio − 1"] + diff_text(e["vs_reference"], 2) for e in pairs]
+            lines += ["", *md_table(PAIR_HEAD, body)]
+    return lines
+
+
+def trainings_csv(tr):
+    head = ["demand", "pr", "training", "training_seed", "against", "seeds", "mean_ratio_pct", "t_lo", "t_hi",
+            "sd_over_seeds", "worst", "worst_seed"]
+    rows = []
+    for x in tr:
+        d, pr = x["cell"]
+        rows += [[d, pr, e["arm"], e["seed"], x["control"], e["n"], e["mean"], e["lo"], e["hi"], e["sd"],
+                  e["worst"], e["worst_seed"]] for e in x["entries"]]
+        lo, hi = x["between_range"]
+        rows.append([d, pr, "between trainings", "", x["control"], len(x["seeds"]), x["mean_of_means"], lo, hi,
+                     x["between_sd"], "", ""])
+        rows.append([d, pr, "within a training (pooled)", "", x["control"], len(x["seeds"]), "", "", "",
+                     x["within_sd"], "", ""])
+    return csv_text(head, rows)
 
 
 def variants_section(var):
@@ -1089,6 +1207,8 @@ def generate(folder, out_dir):
     page += federation_section(fed)
     var = analyse_variants(rows, settings, a)
     page += variants_section(var)
+    tr = analyse_trainings(rows, settings, a)
+    page += trainings_section(tr)
     page += reading_section(a)
     page += ["", "## Figures", ""]
     for name, _, what in FIGURES:
@@ -1102,6 +1222,8 @@ def generate(folder, out_dir):
         texts["results/federation.csv"] = federation_csv(fed)
     if var:
         texts["results/variants.csv"] = variants_csv(var)
+    if tr:
+        texts["results/trainings.csv"] = trainings_csv(tr)
     return texts, a
 
 

@@ -285,6 +285,67 @@ class VariantTest(unittest.TestCase):
         self.assertFalse([l for l in lines if "outside the planned grid" in l and "palcas_margin" in l])
 
 
+class TrainingsTest(unittest.TestCase):
+    """trial.json's trainings: the shipped configuration trained from other seeds, each paired
+    with the cell's best control and with the shipped training, and the spread between the
+    trainings beside the spread between traffic seeds."""
+
+    def setUp(self):
+        self.settings = json.loads((FIXTURE / "trial.json").read_text())
+        self.settings["trainings"] = {"reference": "palcas", "arms": {
+            "palcas": {"seed": 1, "what": "the shipped training"},
+            "palcas_s201": {"seed": 201, "what": "trained from seed 201"},
+            "palcas_s301": {"seed": 301, "what": "trained from seed 301"}}}
+        self.rows = fixture_rows()
+        for arm, factor in (("palcas_s201", 1.02), ("palcas_s301", 0.98)):
+            for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+                self.rows.append(dict(r, arm=arm, point=r["point"].replace("palcas", arm),
+                                      **{SPEED: repr(float(r[SPEED]) * factor)}))
+        self.a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+
+    def test_each_training_against_the_best_control_and_the_spread_between_them(self):
+        tr = trial_results.analyse_trainings(self.rows, self.settings, self.a)
+        self.assertEqual([x["cell"] for x in tr], [LOW], "only where a retraining has rows")
+        x = tr[0]
+        self.assertEqual(x["control"], [c for c in self.a["cells"] if c["cell"] == LOW][0]["best"])
+        self.assertEqual([e["arm"] for e in x["entries"]], ["palcas", "palcas_s201", "palcas_s301"])
+        ref = x["entries"][0]
+        own = trial_results.compare(self.rows, "palcas", x["control"], LOW, SPEED, x["seeds"], ratio=True)
+        self.assertAlmostEqual(ref["mean"], own["mean"])
+        # speed x 1.02: each per-seed value is 1.02 (the reference's) + 2 points.
+        means = [ref["mean"], 1.02 * ref["mean"] + 2.0, 0.98 * ref["mean"] - 2.0]
+        for e, m in zip(x["entries"], means):
+            self.assertAlmostEqual(e["mean"], m)
+        self.assertAlmostEqual(x["between_sd"], trial_results.stdev(means))
+        self.assertAlmostEqual(x["between_range"][0], min(means))
+        pooled = ref["sd"] * math.sqrt((1 + 1.02 ** 2 + 0.98 ** 2) / 3)
+        self.assertAlmostEqual(x["within_sd"], pooled)
+        self.assertAlmostEqual(x["within_se"], pooled / math.sqrt(len(x["seeds"])))
+        up, down = x["entries"][1]["vs_reference"], x["entries"][2]["vs_reference"]
+        self.assertAlmostEqual(up["mean"], 2.0)
+        self.assertAlmostEqual(down["mean"], -2.0)
+        self.assertEqual((trial_results.verdict(up), trial_results.verdict(down)), ("gain", "loss"))
+        page = "\n".join(trial_results.trainings_section(tr))
+        self.assertIn("## Variance across trainings of the shipped configuration", page)
+        self.assertIn("| `palcas_s201` vs `palcas` | speed ratio − 1 |", page)
+        self.assertIn("- Between trainings (3): mean", page)
+        csv_lines = trial_results.trainings_csv(tr).splitlines()
+        self.assertEqual(len(csv_lines), 1 + 3 + 2)
+
+    def test_its_rows_are_counted_and_the_reference_stays_in_the_grid(self):
+        lines = trial_results.what_was_run(self.rows, [FIXTURE / "results.csv"], self.settings, FIXTURE, self.a)
+        self.assertIn("- Trainings of the shipped configuration from other seeds: 6 rows of `palcas_s201`, "
+                      "`palcas_s301` (6 finished)", lines)
+        self.assertFalse([l for l in lines if "outside the planned grid" in l and "palcas_s" in l])
+        self.assertIn("palcas", self.a["learned"], "the reference is still a learned arm of the grid")
+        self.assertTrue(math.isnan(trial_results.stdev([1.0])), "no spread from one training")
+
+    def test_no_section_without_a_retraining(self):
+        only_ref = [r for r in self.rows if r["arm"] not in ("palcas_s201", "palcas_s301")]
+        self.assertEqual(trial_results.analyse_trainings(only_ref, self.settings, self.a), [])
+        self.assertEqual(trial_results.trainings_section([]), [])
+
+
 class MechanismTest(unittest.TestCase):
     def test_the_real_registry(self):
         import yaml
