@@ -110,7 +110,7 @@ std::vector<ReplayedRsu> buildRsus(const Recording& rec, const RsuNodeOptions& b
       throw InputError(id + " on the recorded road: " + e.what());
     }
     try {
-      r.model = palcas::rsu::policyFileIn(checkpoints.string(), id);
+      r.model = palcas::rsu::policyFileIn(checkpoints.string(), id, options.policy_model);
     } catch (const std::runtime_error& e) {
       throw InputError(e.what());
     }

@@ -115,7 +115,7 @@ void RsuDecider::loadInitialModel() {
                    c.rsu_id.c_str(), RANDOM_POLICY);
     return;
   }
-  const fs::path file = policyFileIn(options_.policy_dir, c.rsu_id);
+  const fs::path file = policyFileIn(options_.policy_dir, c.rsu_id, options_.policy_model);
   controller_->loadPolicy(file.string());
   policy_file_ = file.string();
   ROS_INFO_NAMED("startup", "%s: evaluating policy %s", c.rsu_id.c_str(), file.c_str());

@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <regex>
 
 #include "palcas_common/core_params.h"
 #include "palcas_common/v2x_params.h"
@@ -70,6 +73,7 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
   c.scales = params::loadStateScales(p);
   c.pdqn = params::loadPdqnConfig(p);
   o.policy_dir = p.get<std::string>("policy_dir", o.policy_dir);
+  if (secondOf(p, "rsu/policy_model", "global", "folder_order")) o.policy_model = PolicyModel::kFolderOrder;
   o.checkpoint_dir = p.get<std::string>("checkpoint_dir", o.checkpoint_dir);
   o.auth_key_file = p.get<std::string>("auth_key_file", o.auth_key_file);
   if (o.auth_key_file == "none") o.auth_key_file.clear();  // the launch files' "not set"
@@ -170,11 +174,23 @@ void requireEvalWeights(const RsuNodeOptions& o) {
                              "checkpoints/ folder, e.g. policies/palcas/checkpoints)");
 }
 
-std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id) {
+bool defaultIsGlobalModel(const std::string& checkpoints_dir) {
+  std::ifstream in(std::filesystem::path(checkpoints_dir) / ".." / "train.json");
+  if (!in) return false;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // tools/ship_policy.py writes the record with json.dump: "default_model": "global".
+  static const std::regex KEY("\"default_model\"\\s*:\\s*\"global\"");
+  return std::regex_search(text, KEY);
+}
+
+std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id, PolicyModel which) {
   namespace fs = std::filesystem;
   const fs::path dir(checkpoints_dir);
   const fs::path candidates[] = {dir / "fedserver" / "global_model.palcas", dir / rsu_id / "model.palcas",
                                  dir / "default" / "model.palcas"};
+  if (which == PolicyModel::kGlobal && !fs::exists(candidates[0]) && fs::exists(candidates[2]) &&
+      defaultIsGlobalModel(checkpoints_dir))
+    return candidates[2].string();
   for (const fs::path& f : candidates)
     if (fs::exists(f)) return f.string();
   throw std::runtime_error("policy folder '" + checkpoints_dir + "' holds no model for " + rsu_id + ": none of " +

@@ -8,7 +8,11 @@
 
 #include "common/throws_naming.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 
 #include "palcas_rsu/rsu_options.h"
@@ -127,6 +131,49 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "rsu/personal_head_layers");
   expectRefused("residual", [](ros::NodeHandle& nh) { nh.setParam("rsu/residual_default", std::string("none")); },
                 "'none', not one of rule, keep");
+  expectRefused("policy_model", [](ros::NodeHandle& nh) { nh.setParam("rsu/policy_model", std::string("own")); },
+                "'own', not one of global, folder_order");
+}
+
+// The paper runs the federation's global model on every RSU; the shipped files (departures.yaml)
+// run each RSU's own final model where the policy ships one.
+TEST(RsuOptions, WhichModelAnEvaluatingRsuRuns) {
+  using palcas::rsu::PolicyModel;
+  using palcas::rsu::policyFileIn;
+  EXPECT_EQ(loadRsuNodeOptions(ros::NodeHandle("~shipped")).policy_model, PolicyModel::kFolderOrder);
+  EXPECT_EQ(loadRsuNodeOptions(caseFrom("paper_model", [](ros::NodeHandle& nh) {
+              nh.setParam("rsu/policy_model", std::string("global"));
+            })).policy_model,
+            PolicyModel::kGlobal);
+
+  namespace fs = std::filesystem;
+  const fs::path policy = fs::temp_directory_path() / ("rsu_options_policy_" + std::to_string(::getpid()));
+  const fs::path ckpt = policy / "checkpoints";
+  fs::create_directories(ckpt / "rsu_1");
+  fs::create_directories(ckpt / "default");
+  std::ofstream(ckpt / "rsu_1" / "model.palcas") << "own";
+  std::ofstream(ckpt / "default" / "model.palcas") << "global";
+  const std::string own = (ckpt / "rsu_1" / "model.palcas").string();
+  const std::string dflt = (ckpt / "default" / "model.palcas").string();
+  // A default not marked as the global model (e.g. independent's, from one RSU): own first.
+  std::ofstream(policy / "train.json") << "{\"arm\": \"independent\", \"shipped_models\": \"rsu\"}\n";
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kGlobal), own);
+  EXPECT_FALSE(palcas::rsu::defaultIsGlobalModel(ckpt.string()));
+  // Shipped as tools/ship_policy.py --rsu-models writes it.
+  std::ofstream(policy / "train.json") << "{\n \"default_model\": \"global\",\n \"shipped_models\": \"rsu\"\n}\n";
+  EXPECT_TRUE(palcas::rsu::defaultIsGlobalModel(ckpt.string()));
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kGlobal), dflt);
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kFolderOrder), own);
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_7", PolicyModel::kFolderOrder), dflt);  // a zone not trained
+  // A training folder: the server's global model comes first either way.
+  fs::create_directories(ckpt / "fedserver");
+  std::ofstream(ckpt / "fedserver" / "global_model.palcas") << "server";
+  const std::string server = (ckpt / "fedserver" / "global_model.palcas").string();
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kGlobal), server);
+  EXPECT_EQ(policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kFolderOrder), server);
+  fs::remove_all(policy);
+  palcas_test::expectThrowNaming<std::runtime_error>(
+      [&] { policyFileIn(ckpt.string(), "rsu_1", PolicyModel::kGlobal); }, "holds no model for rsu_1");
 }
 
 int main(int argc, char** argv) {

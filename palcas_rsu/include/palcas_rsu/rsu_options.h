@@ -13,6 +13,18 @@
 
 namespace palcas::rsu {
 
+/// Which of a policy folder's models an evaluating RSU loads (rsu/policy_model).
+enum class PolicyModel {
+  /// The folder's order: a training folder's global model, else the RSU's own final model,
+  /// else the default. A shipped policy (tools/ship_policy.py --rsu-models) has no server
+  /// model, so each RSU runs its own final model (PALCAS's departure).
+  kFolderOrder,
+  /// The paper: every RSU runs the federation's global model (fedserver/global_model.palcas,
+  /// else default/model.palcas when the policy's train.json says it is the global model).
+  /// A policy trained without a federation has none and loads in the folder's order.
+  kGlobal,
+};
+
 struct RsuNodeOptions {
   RsuControllerOptions controller;
   /// Zone boundaries (~zones_m); RSU k manages [zones[k], zones[k+1]). Empty = the bridge's.
@@ -24,6 +36,7 @@ struct RsuNodeOptions {
   /// the same weights). false: inline, after publishing the advisories.
   bool learner_thread = true;
   std::string policy_dir;            ///< eval: folder of a trained policy ("" = initial weights)
+  PolicyModel policy_model = PolicyModel::kGlobal;  ///< which of its models (rsu/policy_model; paper: global)
   std::string checkpoint_dir;        ///< "" = no checkpoints; else <dir>/<rsu_id>/
   /// The deployment's key file (palcas_core/common/message_auth.h): advisories and
   /// submissions are signed with it, a global model without its tag is refused. "" =
@@ -82,8 +95,16 @@ void requireEvalWeights(const RsuNodeOptions& o);
 /// The model an evaluating RSU loads from a policy's checkpoints folder, the one place of this
 /// order: the federation's global model (fedserver/global_model.palcas), else the RSU's own
 /// (<rsu_id>/model.palcas), else the policy's default (default/model.palcas, shipped beside
-/// per-RSU models for a zone the training did not have).
+/// per-RSU models for a zone the training did not have). With PolicyModel::kGlobal a shipped
+/// default that is the global model (train.json beside checkpoints/: "default_model":
+/// "global") comes before the RSU's own.
 /// @throws std::runtime_error naming the three candidates when none exists.
-std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id);
+std::string policyFileIn(const std::string& checkpoints_dir, const std::string& rsu_id,
+                         PolicyModel which = PolicyModel::kFolderOrder);
+
+/// Whether the policy whose checkpoints folder is `checkpoints_dir` ships its default model
+/// as the federation's global model (its train.json, one folder up, says "default_model":
+/// "global", as tools/ship_policy.py writes it). False without a readable train.json.
+bool defaultIsGlobalModel(const std::string& checkpoints_dir);
 
 }  // namespace palcas::rsu
