@@ -820,19 +820,25 @@ def analyse_trainings(rows, settings, a):
             vals = [v for _, v in per]
             mean, lo, hi = palcas_stats.t_interval(vals) if vals else (float("nan"),) * 3
             worst = summary(per, "higher") if per else {"worst": float("nan"), "worst_seed": ""}
+            own = arm_cell([r for r in rows if r["seed"] in common], x, cell)["metrics"]
             e = {"arm": x, "seed": arms.get(x, {}).get("seed", ""), "what": arms.get(x, {}).get("what", ""),
                  "n": len(vals), "mean": mean, "lo": lo, "hi": hi, "sd": stdev(vals),
-                 "worst": worst["worst"], "worst_seed": worst["worst_seed"]}
+                 "worst": worst["worst"], "worst_seed": worst["worst_seed"],
+                 "dsr": (own.get("dsr") or {}).get("mean", float("nan")),
+                 "lane_changes": (own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))}
             if x != ref:
                 e["vs_reference"] = compare(rows, x, ref, cell, SPEED, common, ratio=True)
             entries.append(e)
+        ctrl_own = arm_cell([r for r in rows if r["seed"] in common], control, cell)["metrics"]
         means = [e["mean"] for e in entries]
         within = math.sqrt(sum(e["sd"] ** 2 for e in entries) / len(entries)) if entries else float("nan")
         n = len(common)
         out.append({"cell": cell, "control": control, "reference": ref, "seeds": common, "entries": entries,
                     "between_sd": stdev(means), "between_range": (min(means), max(means)),
                     "mean_of_means": sum(means) / len(means), "within_sd": within,
-                    "within_se": within / math.sqrt(n) if n else float("nan")})
+                    "within_se": within / math.sqrt(n) if n else float("nan"),
+                    "control_dsr": (ctrl_own.get("dsr") or {}).get("mean", float("nan")),
+                    "control_lane_changes": (ctrl_own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))})
     return out
 
 
@@ -855,16 +861,19 @@ def trainings_section(tr):
             if e["what"]:
                 lines.append(f"- `{e['arm']}` (training seed {e['seed']}): {e['what']}")
         body = [[f"`{e['arm']}`", str(e["seed"]), str(e["n"]), fmt(e["mean"], 2, signed=True) + " %",
-                 interval(e["lo"], e["hi"], 2), fmt(e["sd"], 2), f"{fmt(e['worst'], 2, signed=True)} % (s{e['worst_seed']})"]
+                 interval(e["lo"], e["hi"], 2), fmt(e["sd"], 2), f"{fmt(e['worst'], 2, signed=True)} % (s{e['worst_seed']})",
+                 fmt(e["dsr"], 1), fmt(e["lane_changes"], 2)]
                 for e in x["entries"]]
         lines += ["", *md_table(["training", "training seed", "seeds", f"speed vs `{x['control']}`",
-                                 "paired-t 95 %", "SD over seeds", "worst seed"], body)]
+                                 "paired-t 95 %", "SD over seeds", "worst seed", "DSR %", "lane changes per CAV"], body)]
         lo, hi = x["between_range"]
         lines += ["", f"- Between trainings ({len(x['entries'])}): mean {fmt(x['mean_of_means'], 2, signed=True)} %, "
                   f"SD {fmt(x['between_sd'], 2)} points, range {fmt(lo, 2, signed=True)} to {fmt(hi, 2, signed=True)} %",
                   f"- Between traffic seeds within a training: SD {fmt(x['within_sd'], 2)} points; the "
                   f"standard error of one training's mean over {len(x['seeds'])} seeds "
-                  f"{fmt(x['within_se'], 2)} points"]
+                  f"{fmt(x['within_se'], 2)} points",
+                  f"- `{x['control']}` on the same seeds: DSR {fmt(x['control_dsr'], 1)} %, lane changes per CAV "
+                  f"{fmt(x['control_lane_changes'], 2)}"]
         pairs = [e for e in x["entries"] if "vs_reference" in e]
         if pairs:
             body = [[f"`{e['arm']}` vs `{ref}`", "speed ratio − 1"] + diff_text(e["vs_reference"], 2) for e in pairs]
@@ -874,17 +883,17 @@ def trainings_section(tr):
 
 def trainings_csv(tr):
     head = ["demand", "pr", "training", "training_seed", "against", "seeds", "mean_ratio_pct", "t_lo", "t_hi",
-            "sd_over_seeds", "worst", "worst_seed"]
+            "sd_over_seeds", "worst", "worst_seed", "dsr_pct", "lane_changes_per_cav"]
     rows = []
     for x in tr:
         d, pr = x["cell"]
         rows += [[d, pr, e["arm"], e["seed"], x["control"], e["n"], e["mean"], e["lo"], e["hi"], e["sd"],
-                  e["worst"], e["worst_seed"]] for e in x["entries"]]
+                  e["worst"], e["worst_seed"], e["dsr"], e["lane_changes"]] for e in x["entries"]]
         lo, hi = x["between_range"]
         rows.append([d, pr, "between trainings", "", x["control"], len(x["seeds"]), x["mean_of_means"], lo, hi,
-                     x["between_sd"], "", ""])
+                     x["between_sd"], "", "", "", ""])
         rows.append([d, pr, "within a training (pooled)", "", x["control"], len(x["seeds"]), "", "", "",
-                     x["within_sd"], "", ""])
+                     x["within_sd"], "", "", "", ""])
     return csv_text(head, rows)
 
 

@@ -317,6 +317,10 @@ class TrainingsTest(unittest.TestCase):
         for e, m in zip(x["entries"], means):
             self.assertAlmostEqual(e["mean"], m)
         self.assertAlmostEqual(x["between_sd"], trial_results.stdev(means))
+        own = trial_results.arm_cell(self.rows, "palcas", LOW)["metrics"]
+        self.assertAlmostEqual(ref["dsr"], own["dsr"]["mean"])
+        self.assertAlmostEqual(x["entries"][1]["lane_changes"], own["lane_changes_per_cav"]["mean"],
+                               msg="only the speed of the copies was changed")
         self.assertAlmostEqual(x["between_range"][0], min(means))
         pooled = ref["sd"] * math.sqrt((1 + 1.02 ** 2 + 0.98 ** 2) / 3)
         self.assertAlmostEqual(x["within_sd"], pooled)
