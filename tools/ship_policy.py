@@ -136,7 +136,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         f"- episodes ended early and not counted: {len(aborted)}" + ("".join("\n  - " + a for a in aborted)),
         ("- models: each RSU's own final model, `checkpoints/<rsu>/model.palcas` (its zone's RSU loads it)"
          + ("; an RSU without one loads `checkpoints/default/model.palcas` ("
-            + ("the federation's final global model" if train.get("default_model") == "global"
+            + ("the federation's final global model; `--rsu-params config/global_model.yaml` runs it on every RSU"
+               if train.get("default_model") == "global"
                else f"{train.get('default_model')}'s model") + ")"
             if train.get("default_model") else "; an RSU without one has no model to load")
          if train["shipped_models"] == "rsu" else
