@@ -75,6 +75,14 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         sys.exit(f"--run-with-bridge: no such file {run_bridge}")
     if default_from and not pf.rsu_model(src, default_from).is_file():
         sys.exit(f"--default-from: {src} holds no checkpoints/{default_from}/model.palcas")
+    learning = repo_paths.usable(train.get("learning", ""))
+    if learning and not pathlib.Path(learning).is_file():
+        # The training writes its schedule into its own folder and records it relative to the
+        # repository it ran in: from another checkout (a worktree), take the folder's copy.
+        own = src / pathlib.Path(learning).name
+        if not own.is_file():
+            sys.exit(f"the training's learning parameters {learning} are gone (nor in {src})")
+        learning = str(own)
     run_bridge = run_bridge or (bridge if bridge_as_trained else None)
     if dst.exists():
         shutil.rmtree(dst)
@@ -103,7 +111,6 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
     for f in pf.RECORD_FILES:
         if (src / f).exists():
             shutil.copy2(src / f, dst / f)
-    learning = repo_paths.usable(train.get("learning", ""))
     if learning:  # the override travels with the policy, referred to by its file name
         shutil.copy2(learning, dst / pathlib.Path(learning).name)
         train["learning"] = pathlib.Path(learning).name

@@ -443,6 +443,22 @@ class ShipPolicy(unittest.TestCase):
         self.assertIn("no such file /nonexistent.yaml", str(e.exception.code))
         self.assertTrue((dest / "bridge.yaml").exists())  # the folder shipped before is kept
 
+    def test_a_schedule_recorded_in_another_checkout_is_taken_from_the_training_folder(self):
+        src = self.training("")
+        record = json.loads((src / "train.json").read_text())
+        record["learning"] = "results/train-x/learning_schedule.yaml"  # relative to the worktree that trained
+        (src / "train.json").write_text(json.dumps(record))
+        (src / "learning_schedule.yaml").write_text("learning:\n  epsilon_start: 1.0\n")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(src), str(dest), rsu_models=True)
+        self.assertEqual((dest / "learning_schedule.yaml").read_text(), "learning:\n  epsilon_start: 1.0\n")
+        self.assertEqual(json.loads((dest / "train.json").read_text())["learning"], "learning_schedule.yaml")
+        (src / "learning_schedule.yaml").unlink()
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(src), str(dest), rsu_models=True)
+        self.assertIn("learning parameters", str(e.exception.code))
+        self.assertTrue((dest / "learning_schedule.yaml").exists(), "the folder shipped before is kept")
+
     def test_the_record_says_how_pr_and_demand_were_drawn(self):
         src = self.training("")
         record = json.loads((src / "train.json").read_text())
