@@ -577,6 +577,12 @@ def what_was_run(rows, files, settings, folder, a):
         lines.append(f"- Trainings of the shipped configuration from other seeds: {len(tr_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in tr_rows}))
                      + f" ({sum(1 for r in tr_rows if r['status'] == 'done')} finished)")
+    alt_only = alternative_arms(settings) - set(variant_arms(settings))
+    alt_rows = [r for r in rows if r["arm"] in alt_only]
+    if alt_rows:
+        lines.append(f"- Trainings of other configurations: {len(alt_rows)} rows of "
+                     + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in alt_rows}))
+                     + f" ({sum(1 for r in alt_rows if r['status'] == 'done')} finished)")
     if extra:
         lines.append(f"- Rows outside the planned grid, not in the tables: "
                      + ", ".join(f"{r.get('point') or r['arm']}" for r in extra))
@@ -724,9 +730,20 @@ def training_reference(settings):
     return (settings.get("trainings") or {}).get("reference") or "palcas"
 
 
+def training_alternatives(settings):
+    """{name: {"what": text, "arms": {arm: {"seed", "what"}}}} of trial.json's trainings: another
+    configuration (an update schedule, say) trained from several seeds, compared with the
+    shipped configuration's trainings, the training being the unit."""
+    return dict((settings.get("trainings") or {}).get("alternatives") or {})
+
+
+def alternative_arms(settings):
+    return {arm for alt in training_alternatives(settings).values() for arm in (alt.get("arms") or {})}
+
+
 def extra_arms(settings):
     """Arms shown in a section of their own, not in the planned grid."""
-    retrained = set(training_arms(settings)) - {training_reference(settings)}
+    retrained = (set(training_arms(settings)) | alternative_arms(settings)) - {training_reference(settings)}
     return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained
 
 
@@ -794,38 +811,72 @@ def stdev(values):
     return math.sqrt(sum((v - m) ** 2 for v in values) / (len(values) - 1))
 
 
+def welch_interval(a, b):
+    """(mean(a) - mean(b), low, high): the two-sided 95 % Welch interval of a difference of two
+    means, with the Welch-Satterthwaite degrees of freedom rounded down (at least 1); the bounds
+    are nan when either side has fewer than 2 values."""
+    diff = sum(a) / len(a) - sum(b) / len(b)
+    if len(a) < 2 or len(b) < 2:
+        return diff, float("nan"), float("nan")
+    va, vb = stdev(a) ** 2 / len(a), stdev(b) ** 2 / len(b)
+    se = math.sqrt(va + vb)
+    if se == 0.0:
+        return diff, diff, diff
+    df = (va + vb) ** 2 / (va ** 2 / (len(a) - 1) + vb ** 2 / (len(b) - 1))
+    half = palcas_stats.t975(max(1, int(df))) * se
+    return diff, diff - half, diff + half
+
+
+def training_entry(rows, cell, arm, info, by_arm, ctrl, common):
+    """One training in one cell: its speed ÷ the control's − 1 per seed of `common`, their mean,
+    paired-t interval, SD and worst seed, and its own DSR and lane changes per CAV."""
+    per = [(s, 100.0 * (by_arm[s] / ctrl[s] - 1.0)) for s in common if ctrl[s]]
+    vals = [v for _, v in per]
+    mean, lo, hi = palcas_stats.t_interval(vals) if vals else (float("nan"),) * 3
+    worst = summary(per, "higher") if per else {"worst": float("nan"), "worst_seed": ""}
+    own = arm_cell([r for r in rows if r["seed"] in common], arm, cell)["metrics"]
+    return {"arm": arm, "seed": info.get("seed", ""), "what": info.get("what", ""),
+            "n": len(vals), "mean": mean, "lo": lo, "hi": hi, "sd": stdev(vals),
+            "worst": worst["worst"], "worst_seed": worst["worst_seed"],
+            "dsr": (own.get("dsr") or {}).get("mean", float("nan")),
+            "lane_changes": (own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))}
+
+
+def by_training_seed(arms):
+    return sorted(arms, key=lambda x: (arms[x].get("seed", 0), x))
+
+
 def analyse_trainings(rows, settings, a):
     """Per cell where the reference and at least one retraining have rows: each training's
     speed ratio to the cell's best control (per seed, on the seeds every training and the
     control finished), the spread between the trainings' means against the spread between
-    traffic seeds within a training, and each retraining paired with the reference."""
+    traffic seeds within a training, and each retraining paired with the reference. Each
+    alternative configuration with at least two finished trainings in the cell: its trainings
+    on the same seeds, and the difference between the two configurations' mean training."""
     arms, ref = training_arms(settings), training_reference(settings)
     if not arms:
         return []
+    alternatives = training_alternatives(settings)
     best = {x["cell"]: x["best"] for x in a["cells"]}
-    order = [ref] + sorted((x for x in arms if x != ref), key=lambda x: (arms[x].get("seed", 0), x))
+    order = [ref] + [x for x in by_training_seed(arms) if x != ref]
     out = []
     for cell in cells_of([r for r in rows if r["arm"] in arms and r["arm"] != ref]):
         control = best.get(cell)
         present = [x for x in order if done_rows(rows, x, cell)]
         if control is None or ref not in present or len(present) < 2:
             continue
-        by_arm = {x: {s: v for s, v, _ in pair(rows, x, control, cell, SPEED)[0]}
-                  for x in present}
+        alt_present = {}
+        for name, alt in sorted(alternatives.items()):
+            have = [x for x in by_training_seed(alt.get("arms") or {}) if done_rows(rows, x, cell)]
+            if len(have) >= 2:
+                alt_present[name] = have
+        everyone = present + [x for have in alt_present.values() for x in have]
+        by_arm = {x: {s: v for s, v, _ in pair(rows, x, control, cell, SPEED)[0]} for x in everyone}
         ctrl = {s: c for s, _, c in pair(rows, ref, control, cell, SPEED)[0]}
         common = sorted(set(ctrl).intersection(*[set(v) for v in by_arm.values()]))
         entries = []
         for x in present:
-            per = [(s, 100.0 * (by_arm[x][s] / ctrl[s] - 1.0)) for s in common if ctrl[s]]
-            vals = [v for _, v in per]
-            mean, lo, hi = palcas_stats.t_interval(vals) if vals else (float("nan"),) * 3
-            worst = summary(per, "higher") if per else {"worst": float("nan"), "worst_seed": ""}
-            own = arm_cell([r for r in rows if r["seed"] in common], x, cell)["metrics"]
-            e = {"arm": x, "seed": arms.get(x, {}).get("seed", ""), "what": arms.get(x, {}).get("what", ""),
-                 "n": len(vals), "mean": mean, "lo": lo, "hi": hi, "sd": stdev(vals),
-                 "worst": worst["worst"], "worst_seed": worst["worst_seed"],
-                 "dsr": (own.get("dsr") or {}).get("mean", float("nan")),
-                 "lane_changes": (own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))}
+            e = training_entry(rows, cell, x, arms.get(x, {}), by_arm[x], ctrl, common)
             if x != ref:
                 e["vs_reference"] = compare(rows, x, ref, cell, SPEED, common, ratio=True)
             entries.append(e)
@@ -833,10 +884,26 @@ def analyse_trainings(rows, settings, a):
         means = [e["mean"] for e in entries]
         within = math.sqrt(sum(e["sd"] ** 2 for e in entries) / len(entries)) if entries else float("nan")
         n = len(common)
+        alts = []
+        for name, have in alt_present.items():
+            info = alternatives[name]
+            alt_entries = [training_entry(rows, cell, x, info["arms"][x], by_arm[x], ctrl, common) for x in have]
+            alt_means = [e["mean"] for e in alt_entries]
+            diff, lo, hi = welch_interval(alt_means, means)
+            alts.append({"name": name, "what": info.get("what", ""), "entries": alt_entries,
+                         "mean_of_means": sum(alt_means) / len(alt_means), "between_sd": stdev(alt_means),
+                         "diff": diff, "lo": lo, "hi": hi,
+                         "verdict": "none" if not (math.isfinite(lo) and (lo > 0 or hi < 0))
+                         else ("gain" if lo > 0 else "loss"),
+                         "dsr": sum(e["dsr"] for e in alt_entries) / len(alt_entries),
+                         "lane_changes": sum(e["lane_changes"] for e in alt_entries) / len(alt_entries)})
         out.append({"cell": cell, "control": control, "reference": ref, "seeds": common, "entries": entries,
                     "between_sd": stdev(means), "between_range": (min(means), max(means)),
                     "mean_of_means": sum(means) / len(means), "within_sd": within,
                     "within_se": within / math.sqrt(n) if n else float("nan"),
+                    "dsr": sum(e["dsr"] for e in entries) / len(entries),
+                    "lane_changes": sum(e["lane_changes"] for e in entries) / len(entries),
+                    "alternatives": alts,
                     "control_dsr": (ctrl_own.get("dsr") or {}).get("mean", float("nan")),
                     "control_lane_changes": (ctrl_own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))})
     return out
@@ -854,18 +921,16 @@ def trainings_section(tr):
              f"those means; between traffic seeds: the pooled standard deviation of the per-seed values "
              f"within a training, and the standard error it gives one training's mean. A difference "
              f"between two trained policies smaller than the spread between trainings of one "
-             f"configuration is not a difference between their configurations."]
+             f"configuration is not a difference between their configurations. So another configuration "
+             f"(trial.json's trainings alternatives) is compared with the training as the unit: its trainings' "
+             f"mean against the shipped trainings' mean, with the Welch 95 % interval over the trainings' "
+             f"means (a configuration with one training has no such interval and is shown only as a variant)."]
     for x in tr:
         lines += ["", f"### {cell_title(x['cell'])}, against `{x['control']}`", ""]
         for e in x["entries"]:
             if e["what"]:
                 lines.append(f"- `{e['arm']}` (training seed {e['seed']}): {e['what']}")
-        body = [[f"`{e['arm']}`", str(e["seed"]), str(e["n"]), fmt(e["mean"], 2, signed=True) + " %",
-                 interval(e["lo"], e["hi"], 2), fmt(e["sd"], 2), f"{fmt(e['worst'], 2, signed=True)} % (s{e['worst_seed']})",
-                 fmt(e["dsr"], 1), fmt(e["lane_changes"], 2)]
-                for e in x["entries"]]
-        lines += ["", *md_table(["training", "training seed", "seeds", f"speed vs `{x['control']}`",
-                                 "paired-t 95 %", "SD over seeds", "worst seed", "DSR %", "lane changes per CAV"], body)]
+        lines += ["", *training_table(x["entries"], x["control"])]
         lo, hi = x["between_range"]
         lines += ["", f"- Between trainings ({len(x['entries'])}): mean {fmt(x['mean_of_means'], 2, signed=True)} %, "
                   f"SD {fmt(x['between_sd'], 2)} points, range {fmt(lo, 2, signed=True)} to {fmt(hi, 2, signed=True)} %",
@@ -878,7 +943,31 @@ def trainings_section(tr):
         if pairs:
             body = [[f"`{e['arm']}` vs `{ref}`", "speed ratio − 1"] + diff_text(e["vs_reference"], 2) for e in pairs]
             lines += ["", *md_table(PAIR_HEAD, body)]
+        for alt in x["alternatives"]:
+            lines += ["", f"#### Another configuration, `{alt['name']}`, trained from {len(alt['entries'])} seeds", ""]
+            if alt["what"]:
+                lines += [alt["what"], ""]
+            lines += training_table(alt["entries"], x["control"])
+            lines += ["", f"- `{alt['name']}` against the shipped configuration, the training as the unit "
+                      f"({len(alt['entries'])} against {len(x['entries'])} trainings, their means over the same "
+                      f"{len(x['seeds'])} seeds): {fmt(alt['mean_of_means'], 2, signed=True)} % against "
+                      f"{fmt(x['mean_of_means'], 2, signed=True)} % vs `{x['control']}`, a difference of "
+                      f"{fmt(alt['diff'], 2, signed=True)} points, Welch 95 % {interval(alt['lo'], alt['hi'], 2)}: "
+                      f"{WORDS[alt['verdict']]}",
+                      f"- Between its trainings: SD {fmt(alt['between_sd'], 2)} points (the shipped "
+                      f"configuration's: {fmt(x['between_sd'], 2)}); mean DSR {fmt(alt['dsr'], 1)} % against "
+                      f"{fmt(x['dsr'], 1)} %, lane changes per CAV {fmt(alt['lane_changes'], 2)} against "
+                      f"{fmt(x['lane_changes'], 2)}"]
     return lines
+
+
+def training_table(entries, control):
+    body = [[f"`{e['arm']}`", str(e["seed"]), str(e["n"]), fmt(e["mean"], 2, signed=True) + " %",
+             interval(e["lo"], e["hi"], 2), fmt(e["sd"], 2), f"{fmt(e['worst'], 2, signed=True)} % (s{e['worst_seed']})",
+             fmt(e["dsr"], 1), fmt(e["lane_changes"], 2)]
+            for e in entries]
+    return md_table(["training", "training seed", "seeds", f"speed vs `{control}`", "paired-t 95 %",
+                     "SD over seeds", "worst seed", "DSR %", "lane changes per CAV"], body)
 
 
 def trainings_csv(tr):
@@ -894,6 +983,12 @@ def trainings_csv(tr):
                      x["between_sd"], "", "", "", ""])
         rows.append([d, pr, "within a training (pooled)", "", x["control"], len(x["seeds"]), "", "", "",
                      x["within_sd"], "", "", "", ""])
+        for alt in x["alternatives"]:
+            rows += [[d, pr, e["arm"], e["seed"], x["control"], e["n"], e["mean"], e["lo"], e["hi"], e["sd"],
+                      e["worst"], e["worst_seed"], e["dsr"], e["lane_changes"]] for e in alt["entries"]]
+            rows.append([d, pr, f"{alt['name']} minus the shipped configuration (Welch, trainings)", "",
+                         x["control"], len(x["seeds"]), alt["diff"], alt["lo"], alt["hi"], alt["between_sd"],
+                         "", "", alt["dsr"] - x["dsr"], alt["lane_changes"] - x["lane_changes"]])
     return csv_text(head, rows)
 
 
@@ -1030,6 +1125,175 @@ def reading_section(a):
             else:
                 lines.append(f"- `{e['learned']}` vs {e['control']}, {n} paired seeds: " + reading_line(e["ratio"], pct=True))
     return lines
+
+
+# --- the learned advice's targets -----------------------------------------------------------
+
+TARGET_DEFAULTS = {
+    "busy_demands": [1400, 1800, 2200],  # where the learned advice must beat the best control
+    "busy_speed_gain_pct": 3.0,          # the better learned mode's speed ÷ best control − 1, at least
+    "cr_margin_points": 0.05,            # CR at most the best control's + this
+    "light_demand": 1000,
+    "advisory_arm": "palcas", "assist_arm": "palcas_assist",
+    "assist_control": "rules_assist", "native_arm": "sumo_native",
+    "light_dsr_pct": 99.5,               # advisory mode's DSR (censored counted), at least
+    "light_lane_change_factor": 1.5,     # its lane changes per CAV ÷ SUMO-native's, at most
+    "light_speed_floor_pct": -0.5,       # its speed ÷ best control − 1, at least
+    "assist_dsr_pct": 100.0,             # assist mode's DSR, at least
+    "decision_p99_ms": 5.0,              # every run's decision p99, below
+    "federation_reference": "palcas", "federation_control": "independent",
+}
+
+
+def target_settings(settings):
+    """trial.json's targets over the defaults; None when the trial names no targets."""
+    if settings.get("targets") is None:
+        return None
+    unknown = set(settings["targets"]) - set(TARGET_DEFAULTS)
+    if unknown:
+        raise TrialError(f"trial.json targets: unknown key(s) {', '.join(sorted(unknown))} "
+                         f"(known: {', '.join(sorted(TARGET_DEFAULTS))})")
+    return dict(TARGET_DEFAULTS, **settings["targets"])
+
+
+def target_row(name, cell, arm, measured, required, met, short=""):
+    return {"target": name, "cell": cell, "arm": arm, "measured": measured, "required": required,
+            "met": bool(met), "short": short if not met else ""}
+
+
+def comparison_of(x, learned, control):
+    for e in x["comparisons"]:
+        if e["learned"] == learned and e["control"] == control:
+            return e
+    return None
+
+
+def metric_of(e, metric):
+    return next(c for c in e["metrics"] if c["metric"] == metric)
+
+
+def with_span(c, digits, unit=""):
+    lo, hi = span(c)
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return f"{fmt(c['mean'], digits, signed=True)}{unit}"
+    return (f"{fmt(c['mean'], digits, signed=True)}{unit} "
+            f"[{fmt_bound(lo, digits, signed=True)}, {fmt_bound(hi, digits, signed=True)}]")
+
+
+def analyse_targets(a, fed, settings):
+    """Each of the learned advice's targets on each cell where its arms ran: what was measured,
+    what is required, met or not, and by how much it fell short."""
+    t = target_settings(settings)
+    if t is None:
+        return []
+    out = []
+    busy = {float(d) for d in t["busy_demands"]}
+    for x in a["cells"]:
+        cell, best = x["cell"], x["best"]
+        if best is None:
+            continue
+        pairs = [e for e in x["comparisons"] if e["best"] and e["ratio"]["n"] >= 2]
+        if cell[0] in busy and pairs:
+            e = max(pairs, key=lambda e: e["ratio"]["mean"])
+            c = e["ratio"]
+            lo = span(c)[0]
+            gain = t["busy_speed_gain_pct"]
+            short = []
+            if c["mean"] < gain:
+                short.append(f"{fmt(gain - c['mean'], 2)} points below +{gain:g} %")
+            if not lo > 0:
+                short.append("interval not above 0")
+            out.append(target_row(f"speed of the better learned mode vs `{best}`", cell, e["learned"],
+                                  with_span(c, 2, " %"), f"≥ +{gain:g} %, interval above 0", not short,
+                                  "; ".join(short)))
+            for metric in ("throughput_vph", "unserved_vehicles", "total_time_spent_veh_h"):
+                c = metric_of(e, metric)
+                out.append(target_row(f"{SHORT[metric]} vs `{best}`", cell, e["learned"],
+                                      with_span(c, digits_of(metric), UNIT[metric]), "no worse (no loss shown)",
+                                      verdict(c) != "loss", "a loss"))
+        for e in pairs:
+            L = e["learned"]
+            own, ctl = x["arms"][L], x["arms"][best]
+            if own.get("cr") and ctl.get("cr"):
+                limit = ctl["cr"]["pct"] + t["cr_margin_points"]
+                out.append(target_row(f"CR vs `{best}`", cell, L, f"{fmt(own['cr']['pct'], 3)} %",
+                                      f"≤ {fmt(limit, 3)} %", own["cr"]["pct"] <= limit,
+                                      f"{fmt(own['cr']['pct'] - limit, 3)} points over"))
+            c = metric_of(e, "comfort_share_pct")
+            if c["n"]:
+                out.append(target_row(f"comfort share vs `{best}`", cell, L, with_span(c, 1, " points"),
+                                      "≥ 0 points (mean)", c["mean"] >= 0.0, f"{fmt(-c['mean'], 1)} points below"))
+            if "p99" in own:
+                limit = t["decision_p99_ms"]
+                out.append(target_row("decision p99, worst run", cell, L, f"{fmt(own['p99']['max'], 2)} ms",
+                                      f"< {limit:g} ms", own["p99"]["max"] < limit,
+                                      f"{fmt(own['p99']['max'] - limit, 2)} ms over"))
+        if cell[0] == float(t["light_demand"]):
+            adv = comparison_of(x, t["advisory_arm"], best)
+            if adv and adv["ratio"]["n"] >= 2:
+                L = t["advisory_arm"]
+                dsr = x["arms"][L]["metrics"].get("dsr")
+                if dsr:
+                    out.append(target_row("advisory mode: DSR", cell, L, f"{fmt(dsr['mean'], 1)} %",
+                                          f"≥ {t['light_dsr_pct']:g} %", dsr["mean"] >= t["light_dsr_pct"],
+                                          f"{fmt(t['light_dsr_pct'] - dsr['mean'], 1)} points below"))
+                lc = x["arms"][L]["metrics"].get("lane_changes_per_cav")
+                native = (x["arms"].get(t["native_arm"]) or {}).get("metrics", {}).get("lane_changes_per_cav")
+                if lc and native and native["mean"] > 0:
+                    factor = lc["mean"] / native["mean"]
+                    limit = t["light_lane_change_factor"]
+                    out.append(target_row(f"advisory mode: lane changes per CAV ÷ `{t['native_arm']}`'s", cell, L,
+                                          f"{fmt(factor, 2)} × ({fmt(lc['mean'], 2)} against {fmt(native['mean'], 2)})",
+                                          f"≤ {limit:g} ×", factor <= limit, f"{fmt(100.0 * (factor / limit - 1.0), 0)} % over"))
+                c, floor = adv["ratio"], t["light_speed_floor_pct"]
+                out.append(target_row(f"advisory mode: speed vs `{best}`", cell, L, with_span(c, 2, " %"),
+                                      f"≥ {fmt(floor, 1, signed=True)} % (mean)", c["mean"] >= floor,
+                                      f"{fmt(floor - c['mean'], 2)} points below"))
+            assist = comparison_of(x, t["assist_arm"], t["assist_control"])
+            if assist and assist["ratio"]["n"] >= 2:
+                L, c = t["assist_arm"], assist["ratio"]
+                out.append(target_row(f"assist mode: speed vs `{t['assist_control']}`", cell, L, with_span(c, 2, " %"),
+                                      "≥ 0 % (mean)", c["mean"] >= 0.0, f"{fmt(-c['mean'], 2)} points below"))
+                dsr = x["arms"][L]["metrics"].get("dsr")
+                if dsr:
+                    out.append(target_row("assist mode: DSR", cell, L, f"{fmt(dsr['mean'], 1)} %",
+                                          f"≥ {t['assist_dsr_pct']:g} %", dsr["mean"] >= t["assist_dsr_pct"],
+                                          f"{fmt(t['assist_dsr_pct'] - dsr['mean'], 1)} points below"))
+    for x in fed:
+        e = next((e for e in x["entries"] if e["arm"] == t["federation_control"]), None)
+        if e is None or x["reference"] != t["federation_reference"] or e["ratio"]["n"] < 2:
+            continue
+        dsr = next(c for c in e["metrics"] if c["metric"] == "dsr")
+        short = [f"{what} {WORDS[verdict(c)]}" for what, c in (("speed", e["ratio"]), ("DSR", dsr))
+                 if verdict(c) != "gain"]
+        out.append(target_row(f"federation: `{x['reference']}` vs `{e['arm']}`, same budget", x["cell"],
+                              x["reference"], f"speed {with_span(e['ratio'], 2, ' %')}; DSR "
+                              f"{with_span(dsr, 1, ' points')}", "a gain on both (intervals above 0)",
+                              not short, "; ".join(short)))
+    return out
+
+
+def targets_section(targets):
+    if not targets:
+        return []
+    met = sum(1 for r in targets if r["met"])
+    lines = ["", "## The learned advice against its targets", "",
+             "Each target of the learned advice (trial.json's `targets` over the generator's defaults) "
+             "on each cell where its arms ran, from the numbers above: against the cell's best control "
+             "unless named; intervals are the span of the bootstrap and paired-t 95 % intervals. A "
+             "comparison made on one training of each side is read with the spread between trainings "
+             "(the section above) in mind.", "",
+             f"**{met} of {len(targets)} met.**", ""]
+    body = [[r["target"], cell_short(r["cell"]), f"`{r['arm']}`", r["measured"], r["required"],
+             "met" if r["met"] else f"**missed**: {r['short']}"] for r in targets]
+    lines += md_table(["target", "cell", "arm", "measured", "required", "reading"], body)
+    return lines
+
+
+def targets_csv(targets):
+    return csv_text(["target", "demand", "pr", "arm", "measured", "required", "met", "short"],
+                    [[r["target"], r["cell"][0], r["cell"][1], r["arm"], r["measured"], r["required"],
+                      "yes" if r["met"] else "no", r["short"]] for r in targets])
 
 
 # --- CSVs and figures ----------------------------------------------------------------------
@@ -1218,6 +1482,8 @@ def generate(folder, out_dir):
     page += variants_section(var)
     tr = analyse_trainings(rows, settings, a)
     page += trainings_section(tr)
+    targets = analyse_targets(a, fed, settings)
+    page += targets_section(targets)
     page += reading_section(a)
     page += ["", "## Figures", ""]
     for name, _, what in FIGURES:
@@ -1233,6 +1499,8 @@ def generate(folder, out_dir):
         texts["results/variants.csv"] = variants_csv(var)
     if tr:
         texts["results/trainings.csv"] = trainings_csv(tr)
+    if targets:
+        texts["results/targets.csv"] = targets_csv(targets)
     return texts, a
 
 

@@ -344,10 +344,137 @@ class TrainingsTest(unittest.TestCase):
         self.assertIn("palcas", self.a["learned"], "the reference is still a learned arm of the grid")
         self.assertTrue(math.isnan(trial_results.stdev([1.0])), "no spread from one training")
 
+    def add_alternative(self, factors):
+        """An alternative configuration whose trainings are the reference's speeds × each factor."""
+        arms = {}
+        for i, factor in enumerate(factors):
+            arm = f"palcas_alt_s{i + 1}"
+            arms[arm] = {"seed": i + 1, "what": f"alternative from seed {i + 1}"}
+            for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+                self.rows.append(dict(r, arm=arm, point=r["point"].replace("palcas", arm),
+                                      **{SPEED: repr(float(r[SPEED]) * factor)}))
+        self.settings["trainings"]["alternatives"] = {"cheap": {"what": "a cheaper schedule", "arms": arms}}
+        self.a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+
+    def test_an_alternative_configuration_is_compared_training_by_training(self):
+        self.add_alternative([0.90, 0.91, 0.89])
+        x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
+        alt = x["alternatives"][0]
+        self.assertEqual([e["arm"] for e in alt["entries"]], ["palcas_alt_s1", "palcas_alt_s2", "palcas_alt_s3"])
+        ref = x["entries"][0]["mean"]
+        means = [f * ref + 100.0 * (f - 1.0) for f in (0.90, 0.91, 0.89)]
+        for e, m in zip(alt["entries"], means):
+            self.assertAlmostEqual(e["mean"], m)
+        shipped = [e["mean"] for e in x["entries"]]
+        diff, lo, hi = trial_results.welch_interval(means, shipped)
+        self.assertAlmostEqual(alt["diff"], sum(means) / 3 - sum(shipped) / 3)
+        self.assertAlmostEqual(alt["lo"], lo)
+        self.assertAlmostEqual(alt["hi"], hi)
+        self.assertEqual(alt["verdict"], "loss", "10 points below, against trainings 2 points apart")
+        page = "\n".join(trial_results.trainings_section([x]))
+        self.assertIn("#### Another configuration, `cheap`, trained from 3 seeds", page)
+        self.assertIn("a cheaper schedule", page)
+        self.assertIn("(3 against 3 trainings, their means over the same", page)
+        self.assertEqual(len(trial_results.trainings_csv([x]).splitlines()), 1 + 3 + 2 + 3 + 1)
+        self.assertIn("palcas_alt_s2", trial_results.extra_arms(self.settings))
+        lines = trial_results.what_was_run(self.rows, [FIXTURE / "results.csv"], self.settings, FIXTURE, self.a)
+        self.assertIn("- Trainings of other configurations: 9 rows of `palcas_alt_s1`, `palcas_alt_s2`, "
+                      "`palcas_alt_s3` (9 finished)", lines)
+
+    def test_an_alternative_inside_the_spread_is_no_difference_and_one_training_is_none(self):
+        self.add_alternative([1.01, 0.99])
+        x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
+        self.assertEqual(x["alternatives"][0]["verdict"], "none")
+        self.rows = [r for r in self.rows if r["arm"] != "palcas_alt_s2"]
+        x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
+        self.assertEqual(x["alternatives"], [], "one training has no spread to compare with")
+
+    def test_the_welch_interval(self):
+        diff, lo, hi = trial_results.welch_interval([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])
+        # Equal variances 1, n 3 and 3: se sqrt(2/3), Welch df 4, t 2.776.
+        half = 2.776 * math.sqrt(2.0 / 3.0)
+        self.assertAlmostEqual(diff, -3.0)
+        self.assertAlmostEqual(lo, -3.0 - half)
+        self.assertAlmostEqual(hi, -3.0 + half)
+        self.assertTrue(math.isnan(trial_results.welch_interval([1.0], [2.0, 3.0])[1]))
+        self.assertEqual(trial_results.welch_interval([1.0, 1.0], [2.0, 2.0]), (-1.0, -1.0, -1.0))
+
     def test_no_section_without_a_retraining(self):
         only_ref = [r for r in self.rows if r["arm"] not in ("palcas_s201", "palcas_s301")]
         self.assertEqual(trial_results.analyse_trainings(only_ref, self.settings, self.a), [])
         self.assertEqual(trial_results.trainings_section([]), [])
+
+
+class TargetsTest(unittest.TestCase):
+    """trial.json's targets: each target of the learned advice on each cell, from the page's own
+    numbers, met or missed and by how much."""
+
+    def setUp(self):
+        self.settings = json.loads((FIXTURE / "trial.json").read_text())
+        self.settings["targets"] = {}
+        self.rows = fixture_rows()
+        self.a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+
+    def targets(self, **override):
+        self.settings["targets"].update(override)
+        return trial_results.analyse_targets(self.a, [], self.settings)
+
+    def find(self, targets, start, cell):
+        return [r for r in targets if r["target"].startswith(start) and r["cell"] == cell]
+
+    def test_no_section_unless_the_trial_names_targets(self):
+        del self.settings["targets"]
+        self.assertEqual(trial_results.analyse_targets(self.a, [], self.settings), [])
+        self.assertEqual(trial_results.targets_section([]), [])
+
+    def test_each_target_is_read_from_the_cells_numbers(self):
+        targets = self.targets()
+        x = {c["cell"]: c for c in self.a["cells"]}
+        best = x[HIGH]["best"]
+        [speed] = self.find(targets, "speed of the better learned mode", HIGH)
+        c = trial_results.compare(self.rows, "palcas", best, HIGH, SPEED, SEEDS, ratio=True)
+        self.assertEqual(speed["met"], c["mean"] >= 3.0 and trial_results.span(c)[0] > 0)
+        self.assertEqual(speed["arm"], "palcas")
+        self.assertEqual(self.find(targets, "speed of the better learned mode", LOW), [],
+                         "1000 is not a busy demand")
+        arms = x[LOW]["arms"]
+        [dsr] = self.find(targets, "advisory mode: DSR", LOW)
+        self.assertEqual(dsr["met"], arms["palcas"]["metrics"]["dsr"]["mean"] >= 99.5)
+        [lc] = self.find(targets, "advisory mode: lane changes", LOW)
+        factor = (arms["palcas"]["metrics"]["lane_changes_per_cav"]["mean"]
+                  / arms["sumo_native"]["metrics"]["lane_changes_per_cav"]["mean"])
+        self.assertTrue(lc["measured"].startswith(trial_results.fmt(factor, 2) + " ×"))
+        self.assertEqual(lc["met"], factor <= 1.5)
+        self.assertEqual(self.find(targets, "assist mode", LOW), [], "no assist arm in the fixture")
+        for r in targets:
+            self.assertEqual(r["short"] == "", r["met"], r)
+
+    def test_the_thresholds_come_from_the_trial(self):
+        for r in self.find(self.targets(decision_p99_ms=1e-6), "decision p99", HIGH):
+            self.assertFalse(r["met"])
+            self.assertIn("ms over", r["short"])
+        [speed] = self.find(self.targets(busy_speed_gain_pct=-1000.0), "speed of the better", HIGH)
+        self.assertNotIn("below", speed["short"], "a gain of -1000 % is always reached")
+        self.assertEqual(self.find(self.targets(busy_demands=[1000]), "speed of the better", HIGH), [])
+        self.settings["targets"] = {"busy_speed_gain": 3}
+        with self.assertRaisesRegex(trial_results.TrialError, "unknown key.*busy_speed_gain"):
+            trial_results.analyse_targets(self.a, [], self.settings)
+
+    def test_the_federation_target_needs_a_gain_on_speed_and_dsr(self):
+        for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            self.rows.append(dict(r, arm="independent", point=r["point"].replace("palcas", "independent"),
+                                  **{SPEED: repr(float(r[SPEED]) / 1.05)}))
+        self.settings["federation"] = {"reference": "palcas", "arms": {"independent": "alone"}}
+        self.a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+        fed = trial_results.analyse_federation(self.rows, self.settings, self.a)
+        [row] = [r for r in trial_results.analyse_targets(self.a, fed, self.settings)
+                 if r["target"].startswith("federation")]
+        self.assertFalse(row["met"])
+        self.assertEqual(row["short"], "DSR no difference shown", "speed +5 % on every seed, DSR equal")
+        page = "\n".join(trial_results.targets_section([row]))
+        self.assertIn("**0 of 1 met.**", page)
+        self.assertIn("**missed**: DSR no difference shown", page)
+        self.assertEqual(len(trial_results.targets_csv([row]).splitlines()), 2)
 
 
 class MechanismTest(unittest.TestCase):
