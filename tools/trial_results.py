@@ -12,7 +12,12 @@ and FOLDER/*/results.csv, merged; a point in two files is an error) and optional
 FOLDER/trial.json naming the settings (the keys of an experiment.json: arms, prs, demands,
 seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, git_commit,
 printed as they are; seeds_by_demand, {"1400": [seeds], ...}, for a part run with fewer seeds
-than the trial's list). Without trial.json the grid is what the rows hold.
+than the trial's list). Sections of their own, each from its key: federation {reference, arms}
+(the same training budget, another scheme), variants {arm: {base, what}} (a learned arm's
+policy run another way), trainings {reference, arms: {arm: {seed, what}}, alternatives: {name:
+{what, arms}}} (the shipped configuration trained from other seeds; another configuration
+trained from several seeds, compared training by training), targets {key: value} (the learned
+advice's targets over TARGET_DEFAULTS). Without trial.json the grid is what the rows hold.
 
 The page: what was run (failed and missing points named); each arm's mechanisms (the
 registry config/arms.json and the bridge parameters it runs under: config/bridge.yaml, then
