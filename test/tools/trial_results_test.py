@@ -7,6 +7,7 @@ from a bridge without the censored rates; its page as generated in fixtures/tria
 
 usage: trial_results_test.py [--xml FILE]   (JUnit XML for ./palcas test)"""
 import contextlib
+import csv
 import io
 import json
 import math
@@ -475,6 +476,61 @@ class TargetsTest(unittest.TestCase):
         self.assertIn("**0 of 1 met.**", page)
         self.assertIn("**missed**: DSR no difference shown", page)
         self.assertEqual(len(trial_results.targets_csv([row]).splitlines()), 2)
+
+
+class TrialRowsTest(unittest.TestCase):
+    """tools/trial_rows.py: an experiment's rows of one arm added to the trial under another name,
+    and nothing written when anything is wrong."""
+
+    def setUp(self):
+        import trial_rows
+        self.tool = trial_rows
+        self.d = pathlib.Path(tempfile.mkdtemp(prefix="palcas_trial_rows_"))
+        self.addCleanup(shutil.rmtree, self.d)
+        self.src = self.d / "results.csv"
+        shutil.copy(FIXTURE / "results.csv", self.src)
+        self.palcas = [r for r in csv.DictReader(open(self.src)) if r["arm"] == "palcas"]
+
+    def test_rows_are_renamed_and_appended(self):
+        out = self.d / "trial" / "results_x.csv"
+        out.parent.mkdir()
+        done = [r for r in self.palcas if r["status"] == "done"]
+        only_done = self.d / "done.csv"
+        with open(only_done, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(self.palcas[0]), lineterminator="\n")
+            w.writeheader()
+            w.writerows(done)
+        self.assertEqual(self.tool.main(["--arm", "palcas", "--as", "palcas_x", "--out", str(out), str(only_done)]), 0)
+        rows = list(csv.DictReader(open(out)))
+        self.assertEqual([r["point"] for r in rows], [r["point"].replace("palcas_", "palcas_x_", 1) for r in done])
+        self.assertEqual({r["arm"] for r in rows}, {"palcas_x"})
+        self.assertEqual([r[SPEED] for r in rows], [r[SPEED] for r in done], "numbers untouched")
+        before = out.read_text()
+        with self.assertRaisesRegex(self.tool.RowsError, "already in"):
+            self.tool.add_rows("palcas", "palcas_x", [str(only_done)], out)
+        self.assertEqual(out.read_text(), before, "nothing written on a refusal")
+
+    def test_refusals_name_what_is_wrong(self):
+        out = self.d / "out.csv"
+        cases = [("palcas", "keep", "an arm of config/arms.json"),
+                 ("no_such_arm", "x", "no row of arm 'no_such_arm'"),
+                 ("palcas", "palcas", "the same name")]
+        for arm, new, why in cases:
+            with self.assertRaisesRegex(self.tool.RowsError, why):
+                self.tool.add_rows(arm, new, [str(self.src)], out)
+        failed = self.d / "failed.csv"
+        with open(failed, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(self.palcas[0]), lineterminator="\n")
+            w.writeheader()
+            w.writerows([self.palcas[0], dict(self.palcas[1], status="failed")])
+        with self.assertRaisesRegex(self.tool.RowsError, "palcas_pr60_d1000_s1002 did not finish"):
+            self.tool.add_rows("palcas", "palcas_x", [str(failed)], out)
+        other = self.d / "other.csv"
+        other.write_text("point,arm,status\npalcas_a,palcas,done\n")
+        with self.assertRaisesRegex(self.tool.RowsError, "columns differ"):
+            self.tool.add_rows("palcas", "palcas_x", [str(self.src), str(other)], out, keep_failed=True)
+        self.assertFalse(out.exists())
+        self.assertEqual(self.tool.main(["--arm", "palcas", "--as", "keep", "--out", str(out), str(self.src)]), 2)
 
 
 class MechanismTest(unittest.TestCase):
