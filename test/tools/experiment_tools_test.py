@@ -31,6 +31,7 @@ import seed_ratio  # noqa: E402
 import training_pace  # noqa: E402
 import ratio_by_demand  # noqa: E402
 import comfort_breakdown  # noqa: E402
+import lane_change_breakdown  # noqa: E402
 import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -728,6 +729,62 @@ class ComfortBreakdownTest(unittest.TestCase):
         with self.assertRaises(SystemExit) as e:
             comfort_breakdown.main([tempfile.gettempdir() + "/no_such_run", "--by-lane-change"])
         self.assertIn("no <arm>/trajectories.csv", str(e.exception))
+
+
+class LaneChangeBreakdownTest(unittest.TestCase):
+    """tools/lane_change_breakdown.py on a hand-made trajectories.csv: the exit lane found, each
+    change classed, the undone ones counted, HDVs and the merge left out, bad input refused."""
+
+    HEAD = "time_s,vehicle,cav,route,exit_cluster,part,x_m,lane,speed_mps,accel_mps2,command,command_accel_mps2,lane_change_target\n"
+
+    def write(self, tracks):
+        d = pathlib.Path(tempfile.mkdtemp(prefix="palcas_lc_"))
+        self.addCleanup(shutil.rmtree, d)
+        lines = [self.HEAD]
+        for vehicle, cav, route, samples in tracks:
+            for t, (part, lane) in enumerate(samples, start=1):
+                lines.append(f"{t},{vehicle},{cav},{route},0,{part},{10 * t},{lane},30,0,none,0,0\n")
+        (d / "trajectories.csv").write_text("".join(lines))
+        return d
+
+    def test_each_change_is_classed(self):
+        m = "mainline"
+        d = self.write([
+            # exit-bound from lane 3 to the exit lane 1, one step away and back: needed 2
+            ("e", 1, "main_exit", [(m, 3), (m, 4), (m, 3), (m, 2), (m, 1), ("off_ramp", 0)]),
+            # through: left and back (undone), then one more left much later
+            ("t", 1, "main_through", [(m, 2), (m, 3), (m, 2)] + [(m, 2)] * 40 + [(m, 3)]),
+            # from the ramp: the merge is a change of part, not of lane; it exits from lane 1
+            ("r", 1, "ramp_exit", [("on_ramp", 0), ("accel_lane", 0), (m, 1), (m, 1), ("off_ramp", 0)]),
+            ("h", 0, "main_through", [(m, 1), (m, 5)]),  # an HDV: not counted
+        ])
+        tracks = lane_change_breakdown.read_tracks(d / "trajectories.csv")
+        self.assertEqual(sorted(tracks), ["e", "r", "t"])
+        self.assertEqual(lane_change_breakdown.exit_lane(tracks), 1)
+        b = lane_change_breakdown.breakdown(tracks, undone_within=30.0)
+        self.assertEqual(b["main_exit"], {"cavs": 1, "needed": 2, "changes": 4, "towards": 3, "away": 1, "undone": 1})
+        self.assertEqual(b["main_through"], {"cavs": 1, "changes": 3, "through": 3, "undone": 1})
+        self.assertEqual(b["ramp_exit"], {"cavs": 1, "needed": 0})
+        self.assertEqual(b["all"]["changes"], 7)
+        self.assertEqual(lane_change_breakdown.breakdown(tracks, undone_within=0.5)["all"].get("undone", 0), 0)
+        out = d / "counts.csv"
+        with contextlib.redirect_stdout(io.StringIO()) as text:
+            self.assertEqual(lane_change_breakdown.main([str(d), "--csv", str(out)]), 0)
+        self.assertIn("| main_exit | 1 | 4.00 | 2.00 | 3 | 1 | 0 | 1 |", text.getvalue())
+        self.assertEqual(len(out.read_text().splitlines()), 1 + 4)
+
+    def test_bad_input_is_refused_by_name(self):
+        d = self.write([("e", 1, "main_exit", [("mainline", 1)])])
+        (d / "trajectories.csv").write_text(self.HEAD + "1,e,1,main_exit,0,mainline,10,x,30,0,none,0,0\n")
+        with self.assertRaisesRegex(lane_change_breakdown.BreakdownError, "line 2: .*lane 'x' is not a number"):
+            lane_change_breakdown.read_tracks(d / "trajectories.csv")
+        (d / "trajectories.csv").write_text("time_s,vehicle\n1,e\n")
+        with self.assertRaisesRegex(lane_change_breakdown.BreakdownError, "not a PALCAS trajectories.csv"):
+            lane_change_breakdown.read_tracks(d / "trajectories.csv")
+        with contextlib.redirect_stderr(io.StringIO()) as err:
+            self.assertEqual(lane_change_breakdown.main([str(d / "nowhere")]), 2)
+            self.assertEqual(lane_change_breakdown.main([str(d), "--undone-within", "0"]), 2)
+        self.assertIn("no trajectories.csv", err.getvalue())
 
 
 class TrainingPaceTest(unittest.TestCase):
