@@ -133,6 +133,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "'none', not one of rule, keep");
   expectRefused("policy_model", [](ros::NodeHandle& nh) { nh.setParam("rsu/policy_model", std::string("own")); },
                 "'own', not one of global, folder_order");
+  expectRefused("exit_side", [](ros::NodeHandle& nh) { nh.setParam("rsu/no_left_for_exit_within_m", -5.0); },
+                "rsu/no_left_for_exit_within_m");
 }
 
 // The paper runs the federation's global model on every RSU; the shipped files (departures.yaml)

@@ -50,6 +50,8 @@ void RsuControllerOptions::validate() const {
           "needs advice_source network (the rule alone departs from nothing)");
   require(std::isfinite(residual_margin) && residual_margin >= 0.0, "residual_margin", residual_margin,
           "must be finite and >= 0");
+  require(std::isfinite(no_left_for_exit_within_m) && no_left_for_exit_within_m >= 0.0, "no_left_for_exit_within_m",
+          no_left_for_exit_within_m, "must be finite and >= 0 (0 = off)");
   nested("rules", [&] { rules.validate(); });
   nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
@@ -143,7 +145,8 @@ std::unordered_map<std::string, StateNow> RsuController::statesNow(
   for (const std::string& id : fates.members) {
     const size_t col = columns.at(id);
     now[id] = StateNow{obs.member_states.col(static_cast<nn::Index>(col)),
-                       possibleActions(obs.member_lanes[col], lanes), obs.member_rewards[col]};
+                       allowedActions(*obs.member_vehicles[col], lanes, options_.no_left_for_exit_within_m),
+                       obs.member_rewards[col]};
   }
   if (fates.outside_zone.empty()) return now;
   const nn::Matrix states = builder_.buildStates(finder, fates.outside_zone, stats, global);
@@ -151,7 +154,7 @@ std::unordered_map<std::string, StateNow> RsuController::statesNow(
   for (size_t i = 0; i < fates.outside_zone.size(); ++i) {
     const std::string& id = fates.outside_zone[i];
     now[id] = StateNow{states.col(static_cast<nn::Index>(i)),
-                       possibleActions(road.at(id)->lane, lanes), rewards[i]};
+                       allowedActions(*road.at(id), lanes, options_.no_left_for_exit_within_m), rewards[i]};
   }
   return now;
 }
@@ -201,6 +204,15 @@ Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes) {
   if ((possibleActions(lane, num_lanes) & actionBit(decision.action)) == 0)
     decision.action = Action::kKeep;
   return decision;
+}
+
+ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double no_left_for_exit_within_m) {
+  ActionMask allowed = possibleActions(vehicle.lane, num_lanes);
+  // Not on the acceleration lane (lane 0): there a left change is the merge itself.
+  if (no_left_for_exit_within_m > 0.0 && vehicle.lane >= 1 && std::isfinite(vehicle.distance_to_exit_m) &&
+      vehicle.distance_to_exit_m < no_left_for_exit_within_m)
+    allowed &= ~actionBit(Action::kLaneLeft);
+  return allowed;
 }
 
 DecisionOutput RsuController::decide(const RoadSnapshot& snapshot, uint64_t step, double time_s,
@@ -301,8 +313,11 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   } else if (!obs.member_ids.empty()) {
     agent_.act(obs.member_states, options_.train, decisions);
   }
-  for (size_t i = 0; i < decisions.size(); ++i)
-    decisions[i] = maskImpossibleLaneChange(decisions[i], obs.member_lanes[i], options_.num_lanes);
+  std::vector<ActionMask> allowed(decisions.size());
+  for (size_t i = 0; i < decisions.size(); ++i) {
+    allowed[i] = allowedActions(*obs.member_vehicles[i], options_.num_lanes, options_.no_left_for_exit_within_m);
+    if ((allowed[i] & actionBit(decisions[i].action)) == 0) decisions[i].action = Action::kKeep;
+  }
 
   counters_.decisions++;
   stats_.member_count = static_cast<uint32_t>(obs.member_ids.size());
@@ -318,7 +333,7 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
     for (size_t i = 0; i < decisions.size(); ++i) {
       PendingDecision& p = decided[obs.member_ids[i]];
       p.state = obs.member_states.col(static_cast<nn::Index>(i));
-      p.valid_actions = possibleActions(obs.member_lanes[i], options_.num_lanes);
+      p.valid_actions = allowed[i];
       p.decision = decisions[i];
       p.reward = obs.member_rewards[i];
       p.distance_to_exit_m = obs.member_exit_m[i];

@@ -863,6 +863,54 @@ TEST(RsuController, PossibleActionsRuleOutLaneChangesOffTheMainline) {
   EXPECT_EQ(possibleActions(1, 1), NO_RIGHT & NO_LEFT);  // one-lane road: accelerate, keep
 }
 
+TEST(RsuController, ExitBoundCavsAreNotSentLeftWithinTheSetDistance) {
+  using palcas::rsu::allowedActions;
+  VehicleSnapshot exiting = cav("x", 3, 1000.0);
+  exiting.distance_to_exit_m = 500.0;
+  EXPECT_EQ(allowedActions(exiting, 5, 0.0), ALL_ACTIONS);  // off (paper)
+  EXPECT_EQ(allowedActions(exiting, 5, 600.0), NO_LEFT);
+  EXPECT_EQ(allowedActions(exiting, 5, 500.0), ALL_ACTIONS);  // not closer than the distance
+  EXPECT_EQ(allowedActions(cav("t", 3, 1000.0), 5, 1e9), ALL_ACTIONS);  // through: no exit
+  exiting.lane = 1;
+  EXPECT_EQ(allowedActions(exiting, 5, 600.0), NO_RIGHT & NO_LEFT);
+  VehicleSnapshot merging = mergingCav("m", 850.0);
+  merging.distance_to_exit_m = 300.0;
+  EXPECT_EQ(allowedActions(merging, 5, 1e9), NO_RIGHT) << "the merge (left from lane 0) stays allowed";
+
+  // In the decision: a left advised to the exit-bound member becomes KEEP, the others keep
+  // theirs, and the stored transition's valid actions leave it out.
+  RsuControllerOptions o = smallOptions();
+  o.no_left_for_exit_within_m = 600.0;
+  o.gradient_steps_per_decision = 0;
+  RsuController c(o);
+  VehicleSnapshot near = cav("a", 3, 1000.0), far = cav("b", 3, 1100.0);
+  near.distance_to_exit_m = 400.0;
+  far.distance_to_exit_m = 900.0;
+  const Decision left{Action::kLaneLeft, 0.0f};
+  const auto advised = [](const DecisionOutput& out) {
+    std::vector<Action> actions;
+    for (const auto& a : out.advisories) actions.push_back(a.decision.action);
+    return actions;
+  };
+  const RoadSnapshot first = road({near, far, cav("c", 2, 1200.0), merging});
+  c.preview(first, 1, GLOBAL, NONE);
+  EXPECT_EQ(advised(c.adviseWith(first, 1, 0.1, GLOBAL, NONE, {left, left, left, left})),
+            (std::vector<Action>{Action::kKeep, Action::kLaneLeft, Action::kLaneLeft, Action::kLaneLeft}));
+  near.x_m += 20.0;
+  far.x_m += 20.0;
+  c.adviseWith(road({near, far, cav("c", 2, 1220.0), merging}), 2, 0.2, GLOBAL, NONE, {left, left, left, left});
+  const auto& replay = c.agent().replay();
+  ASSERT_EQ(replay.size(), 4u);  // a, b, c, m in id order
+  EXPECT_EQ(int(replay.nextValidActionsAt(0)), int(NO_LEFT));
+  EXPECT_EQ(int(replay.nextValidActionsAt(1)), int(ALL_ACTIONS));
+  EXPECT_EQ(int(replay.nextValidActionsAt(3)), int(NO_RIGHT));
+
+  o.no_left_for_exit_within_m = -1.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "no_left_for_exit_within_m");
+  o.no_left_for_exit_within_m = std::numeric_limits<double>::quiet_NaN();
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "no_left_for_exit_within_m");
+}
+
 TEST(RsuController, TransitionsStoreTheValidActionsOfTheirNextState) {
   // Lanes chosen at the edges of a 5-lane road; the mask is that of s' (the lane now).
   RsuController c(smallOptions());

@@ -58,6 +58,10 @@ struct RsuControllerOptions {
   /// for every member (in assist mode: no advice, the CAV's own driving), so the network
   /// speaks only where it is sure that advice beats none.
   ResidualDefault residual_default = ResidualDefault::kRule;
+  /// An exit-bound CAV (finite distance_to_exit_m) closer than this to its off-ramp is never
+  /// advised to change left, away from the exit side: such advice becomes KEEP, and in train
+  /// mode the action is left out of its state's valid actions. >= 0 [m]; 0 (paper) = off.
+  double no_left_for_exit_within_m = 0.0;
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;
@@ -143,6 +147,11 @@ ActionMask possibleActions(int lane, int num_lanes);
 /// it, and the replay should hold the action that was executed. Other decisions are
 /// returned unchanged.
 Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
+
+/// possibleActions() of the vehicle's lane, less a left change when it is exit-bound, on a
+/// mainline lane (the merge from the acceleration lane stays allowed) and closer than
+/// no_left_for_exit_within_m (> 0) to its off-ramp.
+ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double no_left_for_exit_within_m);
 
 /// The controller's counters that a checkpoint carries beside the agent: one key of
 /// controller.txt each (the one list of the keys: rsu_controller_io.cpp; src/doc/rsu.md,
