@@ -491,15 +491,19 @@ class TrialRowsTest(unittest.TestCase):
         shutil.copy(FIXTURE / "results.csv", self.src)
         self.palcas = [r for r in csv.DictReader(open(self.src)) if r["arm"] == "palcas"]
 
+    def write_rows(self, name, rows):
+        path = self.d / name
+        with open(path, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(self.palcas[0]), lineterminator="\n")
+            w.writeheader()
+            w.writerows(rows)
+        return path
+
     def test_rows_are_renamed_and_appended(self):
         out = self.d / "trial" / "results_x.csv"
         out.parent.mkdir()
         done = [r for r in self.palcas if r["status"] == "done"]
-        only_done = self.d / "done.csv"
-        with open(only_done, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(self.palcas[0]), lineterminator="\n")
-            w.writeheader()
-            w.writerows(done)
+        only_done = self.write_rows("done.csv", done)
         self.assertEqual(self.tool.main(["--arm", "palcas", "--as", "palcas_x", "--out", str(out), str(only_done)]), 0)
         rows = list(csv.DictReader(open(out)))
         self.assertEqual([r["point"] for r in rows], [r["point"].replace("palcas_", "palcas_x_", 1) for r in done])
@@ -518,11 +522,7 @@ class TrialRowsTest(unittest.TestCase):
         for arm, new, why in cases:
             with self.assertRaisesRegex(self.tool.RowsError, why):
                 self.tool.add_rows(arm, new, [str(self.src)], out)
-        failed = self.d / "failed.csv"
-        with open(failed, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(self.palcas[0]), lineterminator="\n")
-            w.writeheader()
-            w.writerows([self.palcas[0], dict(self.palcas[1], status="failed")])
+        failed = self.write_rows("failed.csv", [self.palcas[0], dict(self.palcas[1], status="failed")])
         with self.assertRaisesRegex(self.tool.RowsError, "palcas_pr60_d1000_s1002 did not finish"):
             self.tool.add_rows("palcas", "palcas_x", [str(failed)], out)
         other = self.d / "other.csv"
