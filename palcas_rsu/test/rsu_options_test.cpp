@@ -135,6 +135,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "'own', not one of global, folder_order");
   expectRefused("exit_side", [](ros::NodeHandle& nh) { nh.setParam("rsu/no_left_for_exit_within_m", -5.0); },
                 "rsu/no_left_for_exit_within_m");
+  expectRefused("dwell", [](ros::NodeHandle& nh) { nh.setParam("rsu/lane_change_dwell_s", -1.0); },
+                "rsu/lane_change_dwell_s");
 }
 
 // The paper runs the federation's global model on every RSU; the shipped files (departures.yaml)

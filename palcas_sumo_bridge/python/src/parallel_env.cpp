@@ -199,8 +199,8 @@ void ParallelEnvCore::publishStep(const sim::SumoSession& session) {
     any_due_ = true;
     r.global = r.options.i2i ? r.peers->global(r.last_own_density, now_s) : GlobalDensities{kNaN, kNaN, kNaN};
     const rsu::VehicleOutcomes none;
-    r.view = r.controller->preview(*snapshot, step, r.global, r.options.controller.train ? r.outcomes : none);
-    if (r.rewards) r.reward_view = r.rewards->preview(*snapshot, step, r.global, r.outcomes);
+    r.view = r.controller->preview(*snapshot, step, now_s, r.global, r.options.controller.train ? r.outcomes : none);
+    if (r.rewards) r.reward_view = r.rewards->preview(*snapshot, step, now_s, r.global, r.outcomes);
   }
   decision_open_ = std::chrono::steady_clock::now();
 }

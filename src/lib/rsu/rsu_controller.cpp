@@ -30,6 +30,12 @@ void nested(const std::string& prefix, F&& check) {
   }
 }
 
+void requireTime(double time_s, const char* call) {
+  if (!std::isfinite(time_s) || time_s < 0.0)
+    throw std::invalid_argument(std::string("RsuController::") + call + ": time_s = " + std::to_string(time_s) +
+                                " must be finite and >= 0");
+}
+
 // Tolerance of the gradient credit: 10 x 0.1 adds up to 0.99999999999999989.
 constexpr double CREDIT_EPSILON = 1e-9;
 
@@ -52,6 +58,8 @@ void RsuControllerOptions::validate() const {
           "must be finite and >= 0");
   require(std::isfinite(no_left_for_exit_within_m) && no_left_for_exit_within_m >= 0.0, "no_left_for_exit_within_m",
           no_left_for_exit_within_m, "must be finite and >= 0 (0 = off)");
+  require(std::isfinite(lane_change_dwell_s) && lane_change_dwell_s >= 0.0, "lane_change_dwell_s",
+          lane_change_dwell_s, "must be finite and >= 0 (0 = off)");
   nested("rules", [&] { rules.validate(); });
   nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
@@ -139,13 +147,12 @@ std::vector<double> rewardsOf(const NeighbourFinder& finder, const std::vector<s
 std::unordered_map<std::string, StateNow> RsuController::statesNow(
     const Observation& obs, const MemberColumns& columns, const PendingFates& fates,
     const RoadIndex& road, const NeighbourFinder& finder, const ClusterStats& stats,
-    const GlobalDensities& global) const {
-  const int lanes = options_.num_lanes;
+    const GlobalDensities& global, double time_s) const {
   std::unordered_map<std::string, StateNow> now;
   for (const std::string& id : fates.members) {
     const size_t col = columns.at(id);
     now[id] = StateNow{obs.member_states.col(static_cast<nn::Index>(col)),
-                       allowedActions(*obs.member_vehicles[col], lanes, options_.no_left_for_exit_within_m),
+                       allowedFor(*obs.member_vehicles[col], time_s),
                        obs.member_rewards[col]};
   }
   if (fates.outside_zone.empty()) return now;
@@ -154,12 +161,12 @@ std::unordered_map<std::string, StateNow> RsuController::statesNow(
   for (size_t i = 0; i < fates.outside_zone.size(); ++i) {
     const std::string& id = fates.outside_zone[i];
     now[id] = StateNow{states.col(static_cast<nn::Index>(i)),
-                       allowedActions(*road.at(id), lanes, options_.no_left_for_exit_within_m), rewards[i]};
+                       allowedFor(*road.at(id), time_s), rewards[i]};
   }
   return now;
 }
 
-RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
+RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot, double time_s,
                                                   const GlobalDensities& global,
                                                   const VehicleOutcomes& outcomes) const {
   const NeighbourFinder finder(snapshot);  // validates every vehicle, names the bad one
@@ -187,7 +194,7 @@ RsuController::Observation RsuController::observe(const RoadSnapshot& snapshot,
   MemberColumns columns;
   for (size_t i = 0; i < obs.member_ids.size(); ++i) columns.emplace(obs.member_ids[i], i);
   const PendingFates fates = book_.sort(road, columns, events);
-  const auto now = statesNow(obs, columns, fates, road, finder, stats, global);
+  const auto now = statesNow(obs, columns, fates, road, finder, stats, global, time_s);
   obs.closings =
       book_.close(fates, road, now, events, options_.terminal, options_.reward_over_period);
   return obs;
@@ -215,6 +222,41 @@ ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double 
   return allowed;
 }
 
+ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane_change_s, double dwell_s) {
+  if (!(dwell_s > 0.0) || !(since_lane_change_s < dwell_s) || vehicle.lane < 1) return ALL_ACTIONS;
+  ActionMask allowed = ALL_ACTIONS & ~actionBit(Action::kLaneLeft);
+  if (!std::isfinite(vehicle.distance_to_exit_m)) allowed &= ~actionBit(Action::kLaneRight);
+  return allowed;
+}
+
+ActionMask RsuController::allowedFor(const VehicleSnapshot& vehicle, double time_s) const {
+  return allowedActions(vehicle, options_.num_lanes, options_.no_left_for_exit_within_m) &
+         dwellAllowedActions(vehicle, sinceLaneChange(vehicle, time_s), options_.lane_change_dwell_s);
+}
+
+double RsuController::sinceLaneChange(const VehicleSnapshot& vehicle, double time_s) const {
+  constexpr double NEVER = std::numeric_limits<double>::infinity();
+  if (options_.lane_change_dwell_s <= 0.0) return NEVER;
+  const auto seen = lanes_seen_.find(vehicle.id);
+  if (seen == lanes_seen_.end()) return NEVER;
+  if (seen->second.lane != vehicle.lane) return 0.0;
+  return time_s - seen->second.changed_s;  // +inf when never seen to change
+}
+
+void RsuController::rememberLanes(const RoadSnapshot& snapshot, double time_s) {
+  if (options_.lane_change_dwell_s <= 0.0) return;
+  // Rebuilt from the snapshot, so vehicles that left are forgotten.
+  std::unordered_map<std::string, LaneSeen> now;
+  now.reserve(snapshot.vehicles.size());
+  for (const VehicleSnapshot& v : snapshot.vehicles) {
+    const auto seen = lanes_seen_.find(v.id);
+    double changed = -std::numeric_limits<double>::infinity();
+    if (seen != lanes_seen_.end()) changed = seen->second.lane != v.lane ? time_s : seen->second.changed_s;
+    now.emplace(v.id, LaneSeen{v.lane, changed});
+  }
+  lanes_seen_ = std::move(now);
+}
+
 DecisionOutput RsuController::decide(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                                      const GlobalDensities& global,
                                      const VehicleOutcomes& outcomes) {
@@ -227,13 +269,14 @@ void RsuController::learn() {
   if (options_.train) runGradientSteps();
 }
 
-DecisionView RsuController::preview(const RoadSnapshot& snapshot, uint64_t step,
+DecisionView RsuController::preview(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                                     const GlobalDensities& global, const VehicleOutcomes& outcomes) const {
   if (snapshot.num_lanes != options_.num_lanes)
     throw std::invalid_argument("RsuController::preview: snapshot num_lanes = " +
                                 std::to_string(snapshot.num_lanes) + ", this RSU has " +
                                 std::to_string(options_.num_lanes));
-  Observation obs = observe(snapshot, global, outcomes);
+  requireTime(time_s, "preview");
+  Observation obs = observe(snapshot, time_s, global, outcomes);
   DecisionView view;
   view.member_ids = std::move(obs.member_ids);
   view.member_lanes = std::move(obs.member_lanes);
@@ -262,14 +305,12 @@ DecisionOutput RsuController::adviseWith(const RoadSnapshot& snapshot, uint64_t 
 DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t step, double time_s,
                                          const GlobalDensities& global, const VehicleOutcomes& outcomes,
                                          const std::vector<Decision>* given) {
-  if (!std::isfinite(time_s) || time_s < 0.0)
-    throw std::invalid_argument("RsuController::advise: time_s = " + std::to_string(time_s) +
-                                " must be finite and >= 0");
+  requireTime(time_s, "advise");
   if (snapshot.num_lanes != options_.num_lanes)
     throw std::invalid_argument("RsuController::decide: snapshot num_lanes = " +
                                 std::to_string(snapshot.num_lanes) + ", this RSU has " +
                                 std::to_string(options_.num_lanes));
-  Observation obs = observe(snapshot, global, outcomes);  // may throw; nothing changed
+  Observation obs = observe(snapshot, time_s, global, outcomes);  // may throw; nothing changed
   if (given && given->size() != obs.member_ids.size())
     throw std::invalid_argument("RsuController::adviseWith: " + std::to_string(given->size()) +
                                 " decisions for " + std::to_string(obs.member_ids.size()) + " members");
@@ -315,9 +356,10 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   }
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
-    allowed[i] = allowedActions(*obs.member_vehicles[i], options_.num_lanes, options_.no_left_for_exit_within_m);
+    allowed[i] = allowedFor(*obs.member_vehicles[i], time_s);
     if ((allowed[i] & actionBit(decisions[i].action)) == 0) decisions[i].action = Action::kKeep;
   }
+  rememberLanes(snapshot, time_s);
 
   counters_.decisions++;
   stats_.member_count = static_cast<uint32_t>(obs.member_ids.size());
@@ -393,6 +435,7 @@ void RsuController::observeStep(const RoadSnapshot& snapshot) {
 void RsuController::endEpisode() {
   stats_.pending_dropped += book_.dropAll();
   have_last_step_ = false;
+  lanes_seen_.clear();
 }
 
 RsuControllerStats RsuController::stats() const {

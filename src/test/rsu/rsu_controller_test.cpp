@@ -802,7 +802,7 @@ TEST(RsuController, AdviseWithTheNetworksDecisionsIsAdvise) {
   for (int call = 0; call < 3; ++call) {
     const RoadSnapshot r = eightCavs(call);
     const DecisionOutput a = own.advise(r, 1 + call, 0.1 * (call + 1), GLOBAL, NONE);
-    const palcas::rsu::DecisionView view = outside.preview(r, 1 + call, GLOBAL, NONE);
+    const palcas::rsu::DecisionView view = outside.preview(r, 1 + call, 0.1 * (call + 1), GLOBAL, NONE);
     ASSERT_EQ(view.member_ids.size(), a.advisories.size());
     ASSERT_EQ(view.states.cols(), static_cast<palcas::nn::Index>(a.advisories.size()));
     std::vector<Decision> given;
@@ -819,8 +819,8 @@ TEST(RsuController, PreviewShowsTheClosuresAndChangesNothing) {
   RsuController c(smallOptions());
   c.adviseWith(road({cav("a", 1, 900.0, 20.0, 1.0)}), 1, 0.1, GLOBAL, NONE, {Decision{Action::kKeep, 0.0f}});
   const RoadSnapshot now = road({cav("a", 1, 920.0)});
-  const palcas::rsu::DecisionView view = c.preview(now, 2, GLOBAL, NONE);
-  const palcas::rsu::DecisionView again = c.preview(now, 2, GLOBAL, NONE);  // nothing changed
+  const palcas::rsu::DecisionView view = c.preview(now, 2, 0.2, GLOBAL, NONE);
+  const palcas::rsu::DecisionView again = c.preview(now, 2, 0.2, GLOBAL, NONE);  // nothing changed
   ASSERT_EQ(view.closures.size(), 1u);
   ASSERT_EQ(again.closures.size(), 1u);
   EXPECT_EQ(view.closures[0].id, "a");
@@ -835,7 +835,7 @@ TEST(RsuController, PreviewShowsTheClosuresAndChangesNothing) {
   EXPECT_EQ(c.agent().replay().size(), 1u);                     // the transition stored, as advise() would
   EXPECT_NEAR(c.stats().sum_reward, view.closures[0].reward, 1e-9);
   // A step not after the last starts an episode: it closes nothing.
-  EXPECT_TRUE(c.preview(now, 1, GLOBAL, NONE).closures.empty());
+  EXPECT_TRUE(c.preview(now, 1, 0.1, GLOBAL, NONE).closures.empty());
 }
 
 TEST(RsuController, ImpossibleLaneChangesBecomeKeep) {
@@ -893,7 +893,7 @@ TEST(RsuController, ExitBoundCavsAreNotSentLeftWithinTheSetDistance) {
     return actions;
   };
   const RoadSnapshot first = road({near, far, cav("c", 2, 1200.0), merging});
-  c.preview(first, 1, GLOBAL, NONE);
+  c.preview(first, 1, 0.1, GLOBAL, NONE);
   EXPECT_EQ(advised(c.adviseWith(first, 1, 0.1, GLOBAL, NONE, {left, left, left, left})),
             (std::vector<Action>{Action::kKeep, Action::kLaneLeft, Action::kLaneLeft, Action::kLaneLeft}));
   near.x_m += 20.0;
@@ -909,6 +909,58 @@ TEST(RsuController, ExitBoundCavsAreNotSentLeftWithinTheSetDistance) {
   palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "no_left_for_exit_within_m");
   o.no_left_for_exit_within_m = std::numeric_limits<double>::quiet_NaN();
   palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "no_left_for_exit_within_m");
+}
+
+TEST(RsuController, ACavWhoseLaneJustChangedIsNotSentAcrossAgain) {
+  using palcas::rsu::dwellAllowedActions;
+  VehicleSnapshot through = cav("t", 3, 1000.0), exiting = cav("x", 3, 1000.0);
+  exiting.distance_to_exit_m = 700.0;
+  EXPECT_EQ(dwellAllowedActions(through, 5.0, 0.0), ALL_ACTIONS);  // off (paper)
+  EXPECT_EQ(dwellAllowedActions(through, 5.0, 30.0), NO_LEFT & NO_RIGHT);
+  EXPECT_EQ(dwellAllowedActions(through, 30.0, 30.0), ALL_ACTIONS);  // the dwell is over
+  EXPECT_EQ(dwellAllowedActions(exiting, 5.0, 30.0), NO_LEFT) << "towards the exit stays allowed";
+  EXPECT_EQ(dwellAllowedActions(mergingCav("m", 850.0), 0.0, 30.0), ALL_ACTIONS) << "the merge stays allowed";
+
+  RsuControllerOptions o = smallOptions();
+  o.lane_change_dwell_s = 30.0;
+  o.gradient_steps_per_decision = 0;
+  RsuController c(o);
+  const Decision left{Action::kLaneLeft, 0.0f}, right{Action::kLaneRight, 0.0f};
+  const auto actionsOf = [](const DecisionOutput& out) {
+    std::vector<Action> actions;
+    for (const auto& a : out.advisories) actions.push_back(a.decision.action);
+    return actions;
+  };
+  const auto at = [&](double x, int lane_t, int lane_x) {
+    VehicleSnapshot t = cav("t", lane_t, x), e = cav("x", lane_x, x + 100.0);
+    e.distance_to_exit_m = 700.0 - (x - 1000.0);
+    return road({t, e});
+  };
+  // Never seen to change: both may change; then both change lanes (t left, x right).
+  EXPECT_EQ(actionsOf(c.adviseWith(at(1000.0, 3, 3), 1, 1.0, GLOBAL, NONE, {left, right})),
+            (std::vector<Action>{Action::kLaneLeft, Action::kLaneRight}));
+  // 10 s after: t's change back becomes KEEP; x may go on towards its exit, not back left.
+  EXPECT_EQ(actionsOf(c.adviseWith(at(1100.0, 4, 2), 2, 11.0, GLOBAL, NONE, {right, right})),
+            (std::vector<Action>{Action::kKeep, Action::kLaneRight}));
+  EXPECT_EQ(actionsOf(c.adviseWith(at(1200.0, 4, 2), 3, 20.0, GLOBAL, NONE, {right, left})),
+            (std::vector<Action>{Action::kKeep, Action::kKeep}));
+  // The stored transitions' next states (at 11 s, the lanes just changed) leave them out.
+  const auto& replay = c.agent().replay();
+  ASSERT_EQ(replay.size(), 4u);  // t, x at 11 s; t, x at 20 s
+  EXPECT_EQ(int(replay.nextValidActionsAt(0)), int(NO_LEFT & NO_RIGHT));
+  EXPECT_EQ(int(replay.nextValidActionsAt(1)), int(NO_LEFT));
+  // 30 s after the change: free again.
+  EXPECT_EQ(actionsOf(c.adviseWith(at(1300.0, 4, 2), 4, 41.0, GLOBAL, NONE, {right, left})),
+            (std::vector<Action>{Action::kLaneRight, Action::kLaneLeft}));
+  // A new episode forgets the lanes seen.
+  c.adviseWith(at(1000.0, 3, 3), 5, 42.0, GLOBAL, NONE, {left, right});
+  EXPECT_EQ(actionsOf(c.adviseWith(at(1000.0, 2, 2), 1, 0.0, GLOBAL, NONE, {left, left})),
+            (std::vector<Action>{Action::kLaneLeft, Action::kLaneLeft}));
+
+  o.lane_change_dwell_s = -1.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "lane_change_dwell_s");
+  o.lane_change_dwell_s = std::numeric_limits<double>::infinity();
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "lane_change_dwell_s");
 }
 
 TEST(RsuController, TransitionsStoreTheValidActionsOfTheirNextState) {

@@ -62,6 +62,11 @@ struct RsuControllerOptions {
   /// advised to change left, away from the exit side: such advice becomes KEEP, and in train
   /// mode the action is left out of its state's valid actions. >= 0 [m]; 0 (paper) = off.
   double no_left_for_exit_within_m = 0.0;
+  /// A CAV whose lane changed less than this long ago is not advised another lane change,
+  /// except towards its exit (right, when exit-bound) and the merge from the acceleration
+  /// lane: such advice becomes KEEP, and in train mode the action is left out of its state's
+  /// valid actions. The lane is seen at this RSU's decisions. >= 0 [s]; 0 (paper) = off.
+  double lane_change_dwell_s = 0.0;
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;
@@ -153,6 +158,12 @@ Decision maskImpossibleLaneChange(Decision decision, int lane, int num_lanes);
 /// no_left_for_exit_within_m (> 0) to its off-ramp.
 ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double no_left_for_exit_within_m);
 
+/// The actions the dwell leaves a vehicle whose lane changed since_lane_change_s ago: all
+/// when dwell_s is 0 (off), the change is not that recent, or the vehicle is on the
+/// acceleration lane (lane 0: its left change is the merge); otherwise no lane change but
+/// a right one of an exit-bound vehicle (finite distance_to_exit_m), towards its exit.
+ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane_change_s, double dwell_s);
+
 /// The controller's counters that a checkpoint carries beside the agent: one key of
 /// controller.txt each (the one list of the keys: rsu_controller_io.cpp; src/doc/rsu.md,
 /// "Checkpoints").
@@ -194,8 +205,8 @@ class RsuController {
   /// What advise() on the same arguments would see, without changing anything (an outside
   /// learner, palcas_env, chooses the decisions from it and passes them to adviseWith()).
   /// Throws like advise().
-  DecisionView preview(const RoadSnapshot& snapshot, uint64_t step, const GlobalDensities& global,
-                       const VehicleOutcomes& outcomes) const;
+  DecisionView preview(const RoadSnapshot& snapshot, uint64_t step, double time_s,
+                       const GlobalDensities& global, const VehicleOutcomes& outcomes) const;
   /// advise() with the members' decisions given from outside (in preview()'s member order)
   /// instead of the network's or the rule's: the same masking of impossible lane changes and,
   /// in train mode, the same transitions closed and stored. The agent's act() is not called,
@@ -264,15 +275,23 @@ class RsuController {
  private:
   struct Observation;  // everything decide() computes before changing any state
 
-  Observation observe(const RoadSnapshot& snapshot, const GlobalDensities& global,
+  Observation observe(const RoadSnapshot& snapshot, double time_s, const GlobalDensities& global,
                       const VehicleOutcomes& outcomes) const;
+  /// allowedActions() less what the dwell forbids at time_s.
+  ActionMask allowedFor(const VehicleSnapshot& vehicle, double time_s) const;
+  /// Seconds since the vehicle's lane was seen to change (0 when it differs from the lane
+  /// seen at the last decision; +inf when never seen to change or the dwell is off).
+  double sinceLaneChange(const VehicleSnapshot& vehicle, double time_s) const;
+  /// Remembers every vehicle's lane and when it last changed (only with the dwell on).
+  void rememberLanes(const RoadSnapshot& snapshot, double time_s);
   std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
                                                       const MemberColumns& columns,
                                                       const PendingFates& fates,
                                                       const RoadIndex& road,
                                                       const NeighbourFinder& finder,
                                                       const ClusterStats& stats,
-                                                      const GlobalDensities& global) const;
+                                                      const GlobalDensities& global,
+                                                      double time_s) const;
   /// Remembers the closed transitions (id order) and counts them for the stats and n_k.
   void storeClosures(const std::vector<Closure>& closures);
   void runGradientSteps();
@@ -287,6 +306,11 @@ class RsuController {
   std::vector<nn::Network::StateSpan> personal_head_;  ///< kept from the local model on loadGlobalModel
   TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
+  struct LaneSeen {
+    int lane = 0;
+    double changed_s = 0.0;  // -inf: not seen to change
+  };
+  std::unordered_map<std::string, LaneSeen> lanes_seen_;  // lane_change_dwell_s > 0 only
   uint64_t last_step_ = 0;
   ControllerCounters counters_;  // what a checkpoint carries besides the agent
   RsuControllerStats stats_;      // of the last decision (counters_ and the agent's aside)
