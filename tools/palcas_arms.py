@@ -19,6 +19,10 @@ An entry's fields:
   bridge_params     an arm without a shipped policy: the bridge parameters it runs under, a
                     path under config/ ("" = none), so that a control arm drives its CAVs with
                     the same actuation as the learned arms' policies (their bridge.yaml)
+  shipped_rsu_params  (optional, default false) the shipped policy carries RSU parameters it
+                    runs under, policies/<arm>/rsu.yaml (the launch loads it after
+                    config/departures.yaml when it evaluates the shipped policy; roslaunch cannot
+                    ask whether a file exists, so the registry says it, and load() checks it)
 
 JSON because roslaunch's $(eval) reads the same file as a Python literal (it has no YAML
 parser); load() checks both readings agree.
@@ -36,6 +40,8 @@ REGISTRY = ROOT / "config" / "arms.json"
 FIELDS = {"what": str, "title": str, "rsus": str, "federation": bool, "i2i": bool,
           "priority_reward": bool, "advisory_control": bool, "assist_mode": bool,
           "shipped_policy": bool, "advice": str, "bridge_params": str}
+OPTIONAL_FIELDS = {"shipped_rsu_params": bool}
+SHIPPED = ROOT / "policies"
 RSU_RULES = ("zones", "central", "none")
 ADVICE_SOURCES = ("network", "rules", "none")
 # An arm's name becomes a launch argument, a folder name and part of experiment point names.
@@ -53,12 +59,18 @@ def check(arms):
     for name, entry in arms.items():
         if not NAME.match(name):
             raise RegistryError(f"arm '{name}': a name is lower-case letters, digits and _")
-        if not isinstance(entry, dict) or set(entry) != set(FIELDS):
+        if not isinstance(entry, dict) or not set(FIELDS) <= set(entry) <= set(FIELDS) | set(OPTIONAL_FIELDS):
             raise RegistryError(f"arm '{name}': fields {sorted(entry) if isinstance(entry, dict) else entry}, "
-                                f"expected {sorted(FIELDS)}")
-        for field, kind in FIELDS.items():
-            if type(entry[field]) is not kind:
+                                f"expected {sorted(FIELDS)} (and optionally {', '.join(sorted(OPTIONAL_FIELDS))})")
+        for field, kind in {**FIELDS, **OPTIONAL_FIELDS}.items():
+            if field in entry and type(entry[field]) is not kind:
                 raise RegistryError(f"arm '{name}': {field} is not a {kind.__name__}")
+        carries = entry.get("shipped_rsu_params", False)
+        if carries and not entry["shipped_policy"]:
+            raise RegistryError(f"arm '{name}': shipped_rsu_params needs a shipped policy")
+        if entry["shipped_policy"] and carries != (SHIPPED / name / "rsu.yaml").is_file():
+            raise RegistryError(f"arm '{name}': shipped_rsu_params is {str(carries).lower()} but policies/{name}/rsu.yaml "
+                                + ("does not exist" if carries else "exists (the launch would not load it)"))
         if entry["rsus"] not in RSU_RULES:
             raise RegistryError(f"arm '{name}': rsus '{entry['rsus']}' is not one of {', '.join(RSU_RULES)}")
         if entry["rsus"] != "zones" and (entry["federation"] or entry["i2i"]):

@@ -21,6 +21,7 @@ RSU_MODEL = "model.palcas"  # in checkpoints/<rsu>/
 DEFAULT_RSU = "default"  # checkpoints/default/model.palcas: for an RSU without its own model
 LEARNING_LOG = "learning.csv"  # in checkpoints/<rsu>/: per-RSU learning rows
 BRIDGE_PARAMS = "bridge.yaml"  # bridge parameters the policy runs under (over config/bridge.yaml)
+RSU_PARAMS = "rsu.yaml"  # RSU parameters the policy runs under (over config/departures.yaml)
 TRAINING_NOTES = "TRAINING.md"
 EPISODES = "episodes.csv"
 # The training record shipped beside the models.
@@ -59,6 +60,10 @@ def learning_logs(folder):
 
 def bridge_params(folder):
     return pathlib.Path(folder) / BRIDGE_PARAMS
+
+
+def rsu_params(folder):
+    return pathlib.Path(folder) / RSU_PARAMS
 
 
 def train_record_path(folder):

@@ -2,7 +2,7 @@
 """Copies what a user needs of a ./palcas train folder into policies/<arm>/: the
 global model, the training record and its curves; not the replay-laden checkpoints.
 
-usage: ship_policy.py [--rsu-models] [--default-from RSU] [--bridge-as-trained | --run-with-bridge FILE] TRAIN_DIR DEST_DIR
+usage: ship_policy.py [--rsu-models] [--default-from RSU] [--bridge-as-trained | --run-with-bridge FILE] [--run-with-rsu FILE] TRAIN_DIR DEST_DIR
 
 --rsu-models: ship each RSU's own final model (checkpoints/<rsu>/model.palcas: the last
 global model it loaded plus its local steps since) instead of the server's global model, and
@@ -15,6 +15,10 @@ loads for the policy's arm (after config/bridge.yaml, before a --bridge-params o
 --run-with-bridge FILE: the policy runs under FILE's bridge parameters (copied as
 bridge.yaml) although it was not trained under them; TRAINING.md says so.
 Without either a policy runs under config/bridge.yaml, whatever it was trained under.
+--run-with-rsu FILE: the policy's RSUs run under FILE's parameters (copied as rsu.yaml;
+`./palcas run` loads it after config/departures.yaml, before a --rsu-params of its own);
+TRAINING.md says so. A shipped policy with one needs its arm's shipped_rsu_params in
+config/arms.json (the launch reads the registry, not the folder).
 
 DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
 checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
@@ -56,7 +60,8 @@ def traffic_text(train):
     return f"{pr}, {demand}" + (f", V2X channel `{train['v2x_params']}`" if train.get("v2x_params") else "")
 
 
-def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None, default_from=None):
+def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=None, default_from=None,
+         run_rsu=None):
     src = pathlib.Path(train_dir).resolve()
     dst = pathlib.Path(dest)
     train = pf.train_record(src)
@@ -73,6 +78,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
         sys.exit(f"--bridge-as-trained: the training's bridge parameters {bridge} are gone")
     if run_bridge and not pathlib.Path(run_bridge).is_file():
         sys.exit(f"--run-with-bridge: no such file {run_bridge}")
+    if run_rsu and not pathlib.Path(run_rsu).is_file():
+        sys.exit(f"--run-with-rsu: no such file {run_rsu}")
     if default_from and not pf.rsu_model(src, default_from).is_file():
         sys.exit(f"--default-from: {src} holds no checkpoints/{default_from}/model.palcas")
     learning = repo_paths.usable(train.get("learning", ""))
@@ -117,6 +124,9 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
     if run_bridge:
         shutil.copy2(run_bridge, pf.bridge_params(dst))
         train["runs_with_bridge"] = pf.BRIDGE_PARAMS
+    if run_rsu:
+        shutil.copy2(run_rsu, pf.rsu_params(dst))
+        train["runs_with_rsu"] = pf.RSU_PARAMS
     train["shipped_from"] = src.name
     train["shipped_models"] = "rsu" if rsu_models or not global_model.exists() else "global"
     pf.train_record_path(dst).write_text(json.dumps(train) + "\n")
@@ -150,6 +160,8 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
          if train["shipped_models"] == "rsu" else
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
         bridge_line(bridge, run_bridge, bridge_as_trained),
+        *([f"- its RSUs run under the parameters in `{pf.RSU_PARAMS}` (over config/departures.yaml), "
+           f"which its training did not use (`{pathlib.Path(run_rsu).name}`)"] if run_rsu else []),
         "- files: "
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",
@@ -166,8 +178,9 @@ if __name__ == "__main__":
     which = ap.add_mutually_exclusive_group()
     which.add_argument("--bridge-as-trained", action="store_true")
     which.add_argument("--run-with-bridge", metavar="FILE")
+    ap.add_argument("--run-with-rsu", metavar="FILE")
     ap.add_argument("train_dir")
     ap.add_argument("dest_dir")
     a = ap.parse_args()
     main(a.train_dir, a.dest_dir, rsu_models=a.rsu_models, bridge_as_trained=a.bridge_as_trained,
-         run_bridge=a.run_with_bridge, default_from=a.default_from)
+         run_bridge=a.run_with_bridge, default_from=a.default_from, run_rsu=a.run_with_rsu)

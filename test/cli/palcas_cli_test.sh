@@ -95,6 +95,9 @@ cp -r "$ROOT/policies/palcas/checkpoints" "$ROOT/policies/palcas/train.json" \
   "$ROOT/policies/palcas/learning_schedule.yaml" "$BAD_BRIDGE/"
 printf -- '- not a mapping\n' >"$BAD_BRIDGE/bridge.yaml"
 check run_policy_bridge_not_a_mapping "its bridge.yaml is not a YAML mapping" run --out "$OUT" --policy "$BAD_BRIDGE"
+rm "$BAD_BRIDGE/bridge.yaml"
+printf 'rsu: [1, 2\n' >"$BAD_BRIDGE/rsu.yaml"  # not YAML at all
+check run_policy_rsu_not_a_mapping "its rsu.yaml is not a YAML mapping of RSU parameters" run --out "$OUT" --policy "$BAD_BRIDGE"
 check train_bridge_params_missing "--bridge-params '/nonexistent'" train --out "$OUT" --bridge-params /nonexistent
 check experiment_arm_unknown   "--arms: unknown arm 'bogus'" experiment --out "$OUT" --arms keep,bogus
 check experiment_pr_out_of_range "--prs: 150 is outside"    experiment --out "$OUT" --arms keep --prs 5,150

@@ -67,6 +67,34 @@ grep -q '^/palcas_sumo_bridge/lane_change_duration_s: 2.5$' <<<"$params" || why=
 names+=(bridge_parameter_layers); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   bridge_parameter_layers"; else echo "FAIL bridge_parameter_layers: $why"; fi
 
+# A policy's own rsu.yaml (policy_rsu_params) is loaded over config/departures.yaml, under
+# rsu_params, on every RSU (zones and central) and not with paper_printed; the shipped policy's
+# when the registry says it carries one.
+why=""
+printf 'rsu:\n  no_left_for_exit_within_m: 500.0\n  lane_change_dwell_s: 7.0\n' >/tmp/palcas_policy_rsu_$$.yaml
+printf 'rsu:\n  lane_change_dwell_s: 3.0\n' >/tmp/palcas_user_rsu_$$.yaml
+for arm in palcas centralized; do
+  rsu=rsu_0; [ "$arm" = centralized ] && rsu=central
+  params="$(roslaunch --dump-params palcas_launch system.launch arm:=$arm out_dir:=/tmp/unused \
+            policy_rsu_params:=/tmp/palcas_policy_rsu_$$.yaml rsu_params:=/tmp/palcas_user_rsu_$$.yaml 2>&1)"
+  grep -q "^/$rsu/rsu/rsu/no_left_for_exit_within_m: 500.0\$" <<<"$params" || why="$why $arm: the policy's rsu.yaml is not loaded;"
+  grep -q "^/$rsu/rsu/rsu/lane_change_dwell_s: 3.0\$" <<<"$params" || why="$why $arm: rsu_params does not go over the policy's;"
+  grep -q "^/$rsu/rsu/rsu/policy_model: folder_order\$" <<<"$params" || why="$why $arm: departures.yaml is lost;"
+done
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas out_dir:=/tmp/unused paper_printed:=true \
+          policy_rsu_params:=/tmp/palcas_policy_rsu_$$.yaml 2>&1)"
+grep -q '^/rsu_0/rsu/rsu/no_left_for_exit_within_m: 0.0$' <<<"$params" || why="$why paper_printed loads the policy's rsu.yaml;"
+rm -f /tmp/palcas_policy_rsu_$$.yaml /tmp/palcas_user_rsu_$$.yaml
+shipped_rsu="$(/usr/bin/python3 -c 'import sys; sys.path.insert(0, "'"$ROOT"'/tools"); import palcas_arms; print(" ".join(a for a, e in palcas_arms.ARMS.items() if e.get("shipped_rsu_params")))')"
+for arm in $shipped_rsu; do
+  params="$(roslaunch --dump-params palcas_launch system.launch arm:=$arm out_dir:=/tmp/unused 2>&1)"
+  key="$(sed -n 's/^  \([a-z_]*\): .*/\1/p' "$ROOT/policies/$arm/rsu.yaml" | head -n 1)"
+  value="$(sed -n "s/^  $key: \(.*\)/\1/p" "$ROOT/policies/$arm/rsu.yaml" | head -n 1)"
+  grep -q "^/rsu_0/rsu/rsu/$key: $value\$" <<<"$params" || why="$why $arm: its shipped rsu.yaml ($key: $value) is not loaded;"
+done
+names+=(rsu_parameter_layers); failures+=("$why")
+if [ -z "$why" ]; then echo "ok   rsu_parameter_layers"; else echo "FAIL rsu_parameter_layers: $why"; fi
+
 # demand / ramp_demand go over the scenario's flows on the bridge; left out, the scenario's own.
 why=""
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep scenario:=tiny demand:=1850 ramp_demand:=420 out_dir:=/tmp/unused 2>&1)"

@@ -28,6 +28,7 @@ NEW_ARM = "test_arm"
 
 def entry(**kw):
     e = dict(palcas_arms.ARMS["palcas"])
+    e.pop("shipped_rsu_params", None)  # says what policies/palcas/ holds, not what an arm "x" would
     e.update(kw)
     return e
 
@@ -97,6 +98,24 @@ class Registry(unittest.TestCase):
             with self.subTest(text=text), self.assertRaises(palcas_arms.RegistryError) as e:
                 palcas_arms.check(arms)
             self.assertIn(text, str(e.exception))
+
+    def test_the_registry_says_which_shipped_policies_carry_rsu_parameters(self):
+        # roslaunch cannot ask whether policies/<arm>/rsu.yaml exists: the flag must match the files.
+        for arm, e in palcas_arms.ARMS.items():
+            with self.subTest(arm=arm):
+                self.assertEqual(e.get("shipped_rsu_params", False), (ROOT / "policies" / arm / "rsu.yaml").is_file())
+        for arms, text in (({"x": entry(shipped_rsu_params=True)}, "policies/x/rsu.yaml does not exist"),
+                           ({"x": entry(shipped_rsu_params="yes")}, "shipped_rsu_params is not a bool"),
+                           ({"x": entry(shipped_rsu_params=True, shipped_policy=False)}, "needs a shipped policy"),
+                           ({"x": entry(other=True)}, "optionally shipped_rsu_params")):
+            with self.subTest(text=text), self.assertRaises(palcas_arms.RegistryError) as e:
+                palcas_arms.check(arms)
+            self.assertIn(text, str(e.exception))
+        carried = [a for a, e in palcas_arms.ARMS.items() if e.get("shipped_rsu_params")]
+        for arm in carried:  # a file the registry does not know of is refused too
+            with self.subTest(arm=arm), self.assertRaises(palcas_arms.RegistryError) as e:
+                palcas_arms.check({arm: dict(palcas_arms.ARMS[arm], shipped_rsu_params=False)})
+            self.assertIn("exists (the launch would not load it)", str(e.exception))
 
     def test_json_that_roslaunch_would_read_otherwise_is_refused(self):
         with tempfile.TemporaryDirectory() as d:

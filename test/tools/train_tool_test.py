@@ -443,6 +443,22 @@ class ShipPolicy(unittest.TestCase):
         self.assertIn("no such file /nonexistent.yaml", str(e.exception.code))
         self.assertTrue((dest / "bridge.yaml").exists())  # the folder shipped before is kept
 
+    def test_run_with_rsu_carries_rsu_parameters_and_says_so(self):
+        rsu = pathlib.Path(tempfile.mkdtemp()) / "no_left_for_exit.yaml"
+        rsu.write_text("rsu:\n  no_left_for_exit_within_m: 100000.0\n")
+        dest = pathlib.Path(tempfile.mkdtemp()) / "policy"
+        ship_policy.main(str(self.training("")), str(dest), rsu_models=True, run_rsu=str(rsu))
+        self.assertEqual((dest / "rsu.yaml").read_text(), rsu.read_text())
+        self.assertEqual(json.loads((dest / "train.json").read_text())["runs_with_rsu"], "rsu.yaml")
+        self.assertIn("its RSUs run under the parameters in `rsu.yaml` (over config/departures.yaml), which its "
+                      "training did not use (`no_left_for_exit.yaml`)", (dest / "TRAINING.md").read_text())
+        with self.assertRaises(SystemExit) as e:
+            ship_policy.main(str(self.training("")), str(dest), run_rsu="/nonexistent.yaml")
+        self.assertIn("--run-with-rsu: no such file /nonexistent.yaml", str(e.exception.code))
+        self.assertTrue((dest / "rsu.yaml").exists())  # the folder shipped before is kept
+        ship_policy.main(str(self.training("")), str(dest), rsu_models=True)
+        self.assertFalse((dest / "rsu.yaml").exists())  # without the flag, none
+
     def test_a_schedule_recorded_in_another_checkout_is_taken_from_the_training_folder(self):
         src = self.training("")
         record = json.loads((src / "train.json").read_text())

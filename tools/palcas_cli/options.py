@@ -258,9 +258,7 @@ def policy_learning(option, folder):
     return learning
 
 
-def bridge_yaml_ok(option, folder):
-    """A policy folder's bridge.yaml, if it has one, is a mapping of bridge parameters."""
-    path = policy_folder.bridge_params(folder)
+def _params_yaml_ok(option, folder, path, what):
     if not path.exists():
         return
     try:
@@ -269,7 +267,17 @@ def bridge_yaml_ok(option, folder):
     except Exception:  # noqa: BLE001 - unreadable or not YAML: the same answer
         doc = None
     if not (isinstance(doc, dict) and doc):
-        raise OptionError("%s '%s': its bridge.yaml is not a YAML mapping of bridge parameters" % (option, folder))
+        raise OptionError("%s '%s': its %s is not a YAML mapping of %s parameters" % (option, folder, path.name, what))
+
+
+def bridge_yaml_ok(option, folder):
+    """A policy folder's bridge.yaml, if it has one, is a mapping of bridge parameters."""
+    _params_yaml_ok(option, folder, policy_folder.bridge_params(folder), "bridge")
+
+
+def rsu_yaml_ok(option, folder):
+    """A policy folder's rsu.yaml, if it has one, is a mapping of RSU parameters."""
+    _params_yaml_ok(option, folder, policy_folder.rsu_params(folder), "RSU")
 
 
 def known_arm(arm, listed):

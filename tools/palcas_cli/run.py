@@ -140,6 +140,7 @@ def choose_policy(p, arm):
         raise OptionError("%s '%s' was trained for arm %s, not --arm %s" % (label, policy, trained, arm))
     chosen.update(policy=policy, arm=trained, learning=options.policy_learning(label, policy))
     options.bridge_yaml_ok(label, policy)
+    options.rsu_yaml_ok(label, policy)
     learnt_on = options.train_field(policy, "scenario")
     if not chosen["scenario"]:  # the road it learnt on
         chosen["scenario"] = options.scenario_ok("%s '%s': its train.json scenario" % (label, policy), learnt_on)
@@ -220,9 +221,15 @@ def run_arms(p, console, show, rviz):
                 own_bridge = str(policy_folder.bridge_params(p.policy))
                 console.log("%s: under the policy's own bridge parameters %s%s" % (
                     arm, own_bridge, ", then " + p.bridge_params if p.bridge_params else ""))
+            # Its rsu.yaml likewise, for its RSUs (after config/departures.yaml, before --rsu-params).
+            own_rsu = "none"
+            if policy_folder.rsu_params(p.policy).is_file():
+                own_rsu = str(policy_folder.rsu_params(p.policy))
+                console.log("%s: under the policy's own RSU parameters %s%s" % (
+                    arm, own_rsu, ", then " + p.rsu_params if p.rsu_params else ""))
             args += ["mode:=eval", "policy_dir:=%s/checkpoints" % p.policy, "out_dir:=" + folder,
                      "learning_params:=" + p.learning, "paper_printed:=" + p.paper_printed,
-                     "policy_bridge_params:=" + own_bridge]
+                     "policy_bridge_params:=" + own_bridge, "policy_rsu_params:=" + own_rsu]
         else:
             console.log("%s -> %s" % (arm, folder))
             advised = palcas_arms.ARMS.get(arm, {}).get("advisory_control", False)
