@@ -249,10 +249,9 @@ void RsuController::rememberLanes(const RoadSnapshot& snapshot, double time_s) {
   std::unordered_map<std::string, LaneSeen> now;
   now.reserve(snapshot.vehicles.size());
   for (const VehicleSnapshot& v : snapshot.vehicles) {
+    LaneSeen& entry = now[v.id] = LaneSeen{v.lane};
     const auto seen = lanes_seen_.find(v.id);
-    double changed = -std::numeric_limits<double>::infinity();
-    if (seen != lanes_seen_.end()) changed = seen->second.lane != v.lane ? time_s : seen->second.changed_s;
-    now.emplace(v.id, LaneSeen{v.lane, changed});
+    if (seen != lanes_seen_.end()) entry.changed_s = seen->second.lane != v.lane ? time_s : seen->second.changed_s;
   }
   lanes_seen_ = std::move(now);
 }

@@ -306,12 +306,12 @@ class RsuController {
   std::vector<nn::Network::StateSpan> personal_head_;  ///< kept from the local model on loadGlobalModel
   TransitionBook book_;  // pending decisions and limbo
   bool have_last_step_ = false;
+  uint64_t last_step_ = 0;
   struct LaneSeen {
     int lane = 0;
-    double changed_s = 0.0;  // -inf: not seen to change
+    double changed_s = -std::numeric_limits<double>::infinity();  // -inf: never seen to change
   };
   std::unordered_map<std::string, LaneSeen> lanes_seen_;  // lane_change_dwell_s > 0 only
-  uint64_t last_step_ = 0;
   ControllerCounters counters_;  // what a checkpoint carries besides the agent
   RsuControllerStats stats_;      // of the last decision (counters_ and the agent's aside)
   // The checkpoint this controller continues (loaded or last wrote): saveCheckpoint only
