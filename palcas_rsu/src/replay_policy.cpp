@@ -78,6 +78,7 @@ struct ReplayedRsu {
   /// uplink, I2I bookkeeping and controller call as the live RSU.
   std::unique_ptr<palcas::rsu::RsuDecider> decider;
   fs::path model;
+  std::optional<std::uint64_t> last_decided_step;  ///< of the replay
 };
 
 /// One ReplayedRsu per RSU of the recording, each with the node's own options (the loader's,
@@ -155,6 +156,14 @@ struct ReplayCounts {
   std::uint64_t not_decided = 0;              ///< decisions that refused a malformed state
   std::uint64_t i2i_delivered_otherwise = 0;  ///< decisions whose live peer states differ from the bag's order
   std::uint64_t recorded_without_states = 0;  ///< recorded advisories whose states the bag lost
+  std::uint64_t steps_missing = 0;            ///< steps whose vehicle states the bag lost
+  std::uint64_t own_density_from_bag = 0;     ///< decisions given the live RSU's own density, not the replay's
+};
+
+/// An RSU's own density as it published it (its ClusterState) at a decision step.
+struct PublishedDensity {
+  std::uint64_t step = 0;
+  double density_veh_per_km = 0.0;
 };
 
 /// The episode's vehicle states, step by step, through every replayed RSU, each decision
@@ -166,6 +175,7 @@ ReplayCounts replayEpisode(const std::string& bag_path, const Recording& rec, st
   std::set<std::pair<std::uint64_t, std::string>> answered;  // recorded (step, rsu) the replay reached
   std::size_t next_cluster_state = 0;
   std::optional<std::uint64_t> previous_step;
+  std::map<std::string, PublishedDensity> own_published;  // each RSU's last recorded ClusterState
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(STATES_TOPIC))) {
     const auto states = m.instantiate<palcas_msgs::VehicleStateArray>();
     if (!states) continue;
@@ -174,6 +184,9 @@ ReplayCounts replayEpisode(const std::string& bag_path, const Recording& rec, st
       throw InputError("the bag holds more than one episode (" + std::string(STATES_TOPIC) + " go from step " +
                        std::to_string(*previous_step) + " back to " + std::to_string(states->step) +
                        "): replay handles a bag of one episode (./palcas run records one per arm)");
+    // A recorder that falls behind (rosbag record keeps 100 messages per topic) loses states.
+    if (!previous_step) n.steps_missing += states->step;
+    else if (states->step > *previous_step) n.steps_missing += states->step - *previous_step - 1;
     previous_step = states->step;
     // Every RSU hears every step (the V2X uplink when it was on), as the live one did.
     bool decision_step = false;
@@ -194,6 +207,7 @@ ReplayCounts replayEpisode(const std::string& bag_path, const Recording& rec, st
     while (next_cluster_state < rec.cluster_states.size() &&
            rec.cluster_states[next_cluster_state].header.stamp.toSec() < now_s - 1e-9) {
       const palcas_msgs::ClusterState& c = rec.cluster_states[next_cluster_state++];
+      own_published[c.rsu_id] = PublishedDensity{c.step, c.density_veh_per_km};
       for (ReplayedRsu& r : rsus)
         if (r.decider->options().i2i) r.decider->onClusterState(c);  // a malformed one: ignored live too
     }
@@ -203,11 +217,22 @@ ReplayCounts replayEpisode(const std::string& bag_path, const Recording& rec, st
       // Which peer states had reached the live RSU is not in the bag (topics between RSUs
       // race, above all while they connect at start-up): decide on the ones it used.
       std::optional<palcas::GlobalDensities> used;
-      if (r.decider->options().i2i && recorded != rec.advisories.end())
-        used = palcas::GlobalDensities{recorded->second.i2i_upstream_density_veh_per_km, std::nan(""),
+      if (r.decider->options().i2i && recorded != rec.advisories.end()) {
+        // The own density is the zone's at the RSU's previous decision. When the bag lost that
+        // decision's states the replay did not take it, but the live RSU published its density.
+        double own = r.decider->lastOwnDensity();
+        const auto published = own_published.find(r.id);
+        if (published != own_published.end() &&
+            (!r.last_decided_step || published->second.step > *r.last_decided_step)) {
+          if (!sameDensity(own, published->second.density_veh_per_km)) ++n.own_density_from_bag;
+          own = published->second.density_veh_per_km;
+        }
+        used = palcas::GlobalDensities{recorded->second.i2i_upstream_density_veh_per_km, own,
                                        recorded->second.i2i_downstream_density_veh_per_km};
+      }
       const palcas::rsu::RsuDecision d =
           r.decider->decide(*states, palcas::rsu::RsuDecider::Clock::now(), used ? &*used : nullptr);
+      if (d.decided) r.last_decided_step = states->step;
       if (used && (!sameDensity(d.from_peers.upstream, used->upstream) ||
                    !sameDensity(d.from_peers.downstream, used->downstream)))
         ++n.i2i_delivered_otherwise;
@@ -258,6 +283,16 @@ void printReport(const palcas::rsu::ReplayArgs& args, const Recording& rec, cons
     std::printf("I2I: %lu decision(s) where the live RSU had other peer states than the bag's order gives "
                 "(a message not yet received, or one the V2X channel lost or delayed); replayed with the ones it used\n",
                 static_cast<unsigned long>(n.i2i_delivered_otherwise));
+  if (n.steps_missing > 0) {
+    std::printf("states missing from the bag: %lu step(s) (the recorder fell behind)", static_cast<unsigned long>(n.steps_missing));
+    if (rec.i2i)
+      std::printf("; %lu decision(s) replayed with the own density the live RSU published after a lost decision step",
+                  static_cast<unsigned long>(n.own_density_from_bag));
+    // The live uplink heard every step; the replayed one hears only the recorded ones.
+    if (rsus.front().decider->options().v2x.enabled)
+      std::printf("; with the V2X channel on, decisions after a lost step may differ (the live RSU heard it)");
+    std::printf("\n");
+  }
 }
 
 int run(const palcas::rsu::ReplayArgs& args) {

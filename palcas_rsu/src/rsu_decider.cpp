@@ -233,6 +233,7 @@ RsuDecision RsuDecider::decide(const palcas_msgs::VehicleStateArray& states, Clo
     if (options_.i2i && used_densities) {
       global.upstream = used_densities->upstream;
       global.downstream = used_densities->downstream;
+      global.own = used_densities->own;
     }
     // Evaluating, membership comes from the states alone (the bridge drops a removed vehicle
     // from the states of the step that removes it; over the V2X channel the events would race

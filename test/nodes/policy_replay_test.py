@@ -5,6 +5,7 @@ Two short trainings on the tiny road (seeds 7 and 8, small network) give two pol
 as model files; an evaluation of A is recorded (60 s). Then:
   - replaying the bag with A agrees on 100 % of the decisions (no CSV row),
   - replaying it with B reports where it differs (agreement < 100 %, CSV rows, a first divergence),
+  - a bag that lost vehicle states (a recorder behind) still replays at 100 %,
   - bad input is refused with a clear message: not a bag, a bag without the needed topics,
     a folder without a model, a model of another road's state size, no --policy.
 Each launch runs on its own master port; the replays start their own.
@@ -112,6 +113,32 @@ class PolicyReplayTest(unittest.TestCase):
             used = [math.isfinite(m.i2i_upstream_density_veh_per_km) or math.isfinite(m.i2i_downstream_density_veh_per_km)
                     for _, m, _ in bag.read_messages(topics=["/advisories"]) if m.advisories]
         self.assertGreater(sum(used), len(used) // 2, "most decisions should have used a peer's density")
+
+    def test_a_bag_that_lost_states_replays_exactly(self):
+        # A loaded machine makes rosbag record (100 messages per topic) lose vehicle states.
+        # The live RSU still decided on them, and its next decision took that zone density as
+        # its own: the replay takes it from the RSU's recorded cluster state.
+        lost = self.tmp + "/lost_states.bag"
+        dropped = {150, 250, 350, 450}  # decision steps (every 10)
+        kept = set()
+        with rosbag.Bag(self.bag) as src, rosbag.Bag(lost, "w") as dst:
+            for topic, msg, t in src.read_messages():
+                if topic == "/vehicle_states":
+                    if msg.step in dropped:
+                        continue
+                    kept.add(msg.step)
+                dst.write(topic, msg, t)
+        r = replay(lost, "--policy", self.policies["A"], "--csv", self.tmp + "/lost.csv")
+        print(r.stdout)
+        self.assertEqual(r.returncode, 0, r.stdout)
+        compared, percent = agreement(r.stdout)
+        self.assertGreater(compared, 50, r.stdout)
+        self.assertEqual(percent, 100.0, r.stdout)
+        m = re.search(r"states missing from the bag: (\d+) step\(s\).*; (\d+) decision\(s\) replayed with the own density",
+                      r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        self.assertEqual(int(m.group(1)), max(kept) + 1 - len(kept))  # the recorder may have lost some too
+        self.assertGreater(int(m.group(2)), 0, r.stdout)
 
     def test_a_recording_through_the_v2x_channel_replays_exactly(self):
         r = replay(self.v2x_bag, "--policy", self.policies["A"], "--csv", self.tmp + "/v2x.csv")

@@ -102,8 +102,9 @@ class RsuDecider {
   bool onStates(const palcas_msgs::VehicleStateArray& states);
   /// The decision on a decision step's state; `received` is when the state arrived (for
   /// decision_ms). A malformed state is answered empty, not thrown. `used_densities` (with
-  /// I2I on): decide on these neighbours' densities instead of the peers' states received
-  /// (replay_policy: the ones a recording says the live RSU used); null = the peers'.
+  /// I2I on): decide on these global densities (the neighbours' and this zone's own at its
+  /// previous decision) instead of the peers' states received and lastOwnDensity()
+  /// (replay_policy: the ones a recording says the live RSU used); null = its own.
   RsuDecision decide(const palcas_msgs::VehicleStateArray& states, Clock::time_point received,
                      const GlobalDensities* used_densities = nullptr);
   /// What follows a sent decision (see the header comment); returns the decision's status.
@@ -119,6 +120,9 @@ class RsuDecider {
   const RsuController& controller() const { return *controller_; }
   const RsuSchedule& schedule() const { return schedule_; }
   const PeerStates& peers() const { return peers_; }
+  /// This zone's density at its previous decision (NaN before the first): the "own" global
+  /// density the next decision takes.
+  double lastOwnDensity() const { return last_own_density_; }
   /// The policy file evaluated ("" in training and for the rule).
   const std::string& policyFile() const { return policy_file_; }
   bool federationReachable() const { return federation_ && federation_->reachable(); }
