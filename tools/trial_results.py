@@ -13,8 +13,9 @@ FOLDER/trial.json naming the settings (the keys of an experiment.json: arms, prs
 seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, git_commit,
 printed as they are; seeds_by_demand, {"1400": [seeds], ...}, for a part run with fewer seeds
 than the trial's list). Sections of their own, each from its key: federation {reference, arms}
-(the same training budget, another scheme), variants {arm: {base, what}} (a learned arm's
-policy run another way), trainings {reference, arms: {arm: {seed, what}}, alternatives: {name:
+(the same training budget, another scheme), variants {arm: {base, what, ships}} (a learned arm's
+policy run another way; with ships true, the way the base arm's shipped policy now runs, which
+the targets read in place of the base's own rows), trainings {reference, arms: {arm: {seed, what}}, alternatives: {name:
 {what, arms}}} (the shipped configuration trained from other seeds; another configuration
 trained from several seeds, compared training by training), targets {key: value} (the learned
 advice's targets over TARGET_DEFAULTS). Without trial.json the grid is what the rows hold.
@@ -725,6 +726,30 @@ def variant_arms(settings):
     return dict(settings.get("variants") or {})
 
 
+def shipped_variants(settings):
+    """{base arm: variant} of the variants trial.json marks `"ships": true`: the way the base
+    arm's shipped policy now runs (its policy folder's rsu.yaml, say), so that the targets read
+    what ships, not the rows the trial ran before."""
+    out = {}
+    for arm, v in variant_arms(settings).items():
+        if not v.get("ships"):
+            continue
+        base = v.get("base")
+        if not base:
+            raise TrialError(f"trial.json variants: '{arm}' ships but names no base arm")
+        if base in out:
+            raise TrialError(f"trial.json variants: '{out[base]}' and '{arm}' both ship as '{base}'")
+        out[base] = arm
+    return out
+
+
+def as_shipped(rows, shipped):
+    """The rows with each shipping variant's rows standing for its base arm, whose own rows are
+    left out: a cell where the variant did not run has no rows of the base."""
+    base_of = {variant: base for base, variant in shipped.items()}
+    return [dict(r, arm=base_of.get(r["arm"], r["arm"])) for r in rows if r["arm"] not in shipped]
+
+
 def training_arms(settings):
     """{arm: {"seed": training seed, "what": text}} of trial.json's trainings: the shipped
     configuration trained again from other seeds, its reference (the shipped policy) among them."""
@@ -1162,7 +1187,7 @@ def target_settings(settings):
 
 
 def target_row(name, cell, arm, measured, required, met, short=""):
-    return {"target": name, "cell": cell, "arm": arm, "measured": measured, "required": required,
+    return {"target": name, "cell": cell, "arm": arm, "rows_of": arm, "measured": measured, "required": required,
             "met": bool(met), "short": short if not met else ""}
 
 
@@ -1185,12 +1210,21 @@ def with_span(c, digits, unit=""):
             f"[{fmt_bound(lo, digits, signed=True)}, {fmt_bound(hi, digits, signed=True)}]")
 
 
-def analyse_targets(a, fed, settings):
+def analyse_targets(a, fed, settings, shipped=None):
     """Each of the learned advice's targets on each cell where its arms ran: what was measured,
-    what is required, met or not, and by how much it fell short."""
+    what is required, met or not, and by how much it fell short. `a` is analyse() of the rows as
+    shipped (as_shipped()); `shipped` {base arm: variant} names whose rows stand for an arm."""
     t = target_settings(settings)
     if t is None:
         return []
+    out = []
+    for r in _targets(a, fed, t):
+        r["rows_of"] = (shipped or {}).get(r["arm"], r["arm"])
+        out.append(r)
+    return out
+
+
+def _targets(a, fed, t):
     out = []
     busy = {float(d) for d in t["busy_demands"]}
     for x in a["cells"]:
@@ -1282,22 +1316,31 @@ def targets_section(targets):
     if not targets:
         return []
     met = sum(1 for r in targets if r["met"])
+    stand_ins = sorted({(r["arm"], r["rows_of"]) for r in targets if r["rows_of"] != r["arm"]})
     lines = ["", "## The learned advice against its targets", "",
              "Each target of the learned advice (trial.json's `targets` over the generator's defaults) "
              "on each cell where its arms ran, from the numbers above: against the cell's best control "
              "unless named; intervals are the span of the bootstrap and paired-t 95 % intervals. A "
              "comparison made on one training of each side is read with the spread between trainings "
-             "(the section above) in mind.", "",
-             f"**{met} of {len(targets)} met.**", ""]
-    body = [[r["target"], cell_short(r["cell"]), f"`{r['arm']}`", r["measured"], r["required"],
+             "(the section above) in mind."]
+    for arm, variant in stand_ins:
+        lines[-1] += (f" `{arm}` is read as it ships: from the rows of the variant `{variant}` (above), "
+                      f"not the trial's own `{arm}` rows; a cell where the variant did not run has no "
+                      f"`{arm}` target.")
+    lines += ["", f"**{met} of {len(targets)} met.**", ""]
+    body = [[r["target"], cell_short(r["cell"]), arm_shown(r), r["measured"], r["required"],
              "met" if r["met"] else f"**missed**: {r['short']}"] for r in targets]
     lines += md_table(["target", "cell", "arm", "measured", "required", "reading"], body)
     return lines
 
 
+def arm_shown(r):
+    return f"`{r['arm']}`" if r["rows_of"] == r["arm"] else f"`{r['arm']}` (`{r['rows_of']}`)"
+
+
 def targets_csv(targets):
-    return csv_text(["target", "demand", "pr", "arm", "measured", "required", "met", "short"],
-                    [[r["target"], r["cell"][0], r["cell"][1], r["arm"], r["measured"], r["required"],
+    return csv_text(["target", "demand", "pr", "arm", "rows_of", "measured", "required", "met", "short"],
+                    [[r["target"], r["cell"][0], r["cell"][1], r["arm"], r["rows_of"], r["measured"], r["required"],
                       "yes" if r["met"] else "no", r["short"]] for r in targets])
 
 
@@ -1487,7 +1530,9 @@ def generate(folder, out_dir):
     page += variants_section(var)
     tr = analyse_trainings(rows, settings, a)
     page += trainings_section(tr)
-    targets = analyse_targets(a, fed, settings)
+    shipped = shipped_variants(settings)
+    as_run = analyse(as_shipped(rows, shipped), settings, registry) if shipped else a
+    targets = analyse_targets(as_run, fed, settings, shipped)
     page += targets_section(targets)
     page += reading_section(a)
     page += ["", "## Figures", ""]

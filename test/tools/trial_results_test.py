@@ -461,6 +461,38 @@ class TargetsTest(unittest.TestCase):
         with self.assertRaisesRegex(trial_results.TrialError, "unknown key.*busy_speed_gain"):
             trial_results.analyse_targets(self.a, [], self.settings)
 
+    def test_a_shipping_variant_stands_for_its_base(self):
+        # palcas now ships another way, run at LOW only: its rows are what the targets read.
+        for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            self.rows.append(dict(r, arm="palcas_shipped", point=r["point"].replace("palcas", "palcas_shipped"),
+                                  **{SPEED: repr(float(r[SPEED]) * 1.05)}))
+        self.settings["variants"] = {"palcas_shipped": {"base": "palcas", "what": "as shipped", "ships": True},
+                                     "palcas_other": {"base": "palcas", "what": "not shipped"}}
+        shipped = trial_results.shipped_variants(self.settings)
+        self.assertEqual(shipped, {"palcas": "palcas_shipped"})
+        rows = trial_results.as_shipped(self.rows, shipped)
+        self.assertFalse([r for r in rows if r["arm"] == "palcas_shipped"])
+        self.assertFalse([r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == HIGH])
+        a = trial_results.analyse(rows, self.settings, trial_results.load_registry())
+        targets = trial_results.analyse_targets(a, [], self.settings, shipped)
+        best = [x for x in a["cells"] if x["cell"] == LOW][0]["best"]
+        [speed] = self.find(targets, "advisory mode: speed", LOW)
+        self.assertEqual((speed["arm"], speed["rows_of"]), ("palcas", "palcas_shipped"))
+        c = trial_results.compare(self.rows, "palcas_shipped", best, LOW, SPEED, SEEDS, ratio=True)
+        self.assertTrue(speed["measured"].startswith(trial_results.fmt(c["mean"], 2, signed=True) + " %"), speed)
+        self.assertFalse([r for r in targets if r["cell"] == HIGH and r["arm"] == "palcas"],
+                         "the shipped way did not run at HIGH: no target of palcas there")
+        page = "\n".join(trial_results.targets_section(targets))
+        self.assertIn("| `palcas` (`palcas_shipped`) |", page)
+        self.assertIn("`palcas` is read as it ships: from the rows of the variant `palcas_shipped`", page)
+        self.assertIn(",palcas,palcas_shipped,", trial_results.targets_csv(targets))
+        self.settings["variants"]["palcas_other"]["ships"] = True
+        with self.assertRaisesRegex(trial_results.TrialError, "both ship as 'palcas'"):
+            trial_results.shipped_variants(self.settings)
+        self.settings["variants"] = {"palcas_shipped": {"what": "no base", "ships": True}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'palcas_shipped' ships but names no base"):
+            trial_results.shipped_variants(self.settings)
+
     def test_the_federation_target_needs_a_gain_on_speed_and_dsr(self):
         for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
             self.rows.append(dict(r, arm="independent", point=r["point"].replace("palcas", "independent"),
