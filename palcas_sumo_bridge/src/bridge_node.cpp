@@ -126,8 +126,12 @@ bool BridgeNode::waitForPeers() {
     const std::size_t rsu_nodes = inprocess_ ? 0 : options_.expected_rsus.size() - runner_->lockstep().unregistered().size();
     return static_cast<std::uint32_t>(options_.min_subscribers) + static_cast<std::uint32_t>(rsu_nodes);
   };
+  // The view's recorder (record.launch) is its own process: a late one missed the first
+  // markers and tf (on a loaded machine once the first 40 s of a 60 s episode).
+  const auto markers_needed = static_cast<std::uint32_t>(options_.min_marker_subscribers);
   auto ready = [&] {
-    return runner_->lockstep().allRegistered() && states_pub_.getNumSubscribers() >= subscribers_needed();
+    return runner_->lockstep().allRegistered() && states_pub_.getNumSubscribers() >= subscribers_needed() &&
+           markers_pub_.getNumSubscribers() >= markers_needed;
   };
   // Publish the clock so nodes on sim time can start; RSUs register once subscribed.
   rosgraph_msgs::Clock clock;
@@ -140,6 +144,9 @@ bool BridgeNode::waitForPeers() {
     ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
              states_pub_.getNumSubscribers(), subscribers_needed(), VEHICLE_STATES_TOPIC,
              options_.startup_timeout_s);
+  if (markers_pub_.getNumSubscribers() < markers_needed)
+    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
+             markers_pub_.getNumSubscribers(), markers_needed, MARKERS_TOPIC, options_.startup_timeout_s);
   if (runner_->lockstep().allRegistered()) return true;
   std::string missing;
   for (const std::string& id : runner_->lockstep().unregistered()) missing += " " + id;

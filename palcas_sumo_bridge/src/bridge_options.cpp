@@ -139,6 +139,7 @@ BridgeOptions loadBridgeOptions(const ros::NodeHandle& private_nh, common::Param
   o.lockstep_deadline_s = p.number("lockstep_deadline_s", o.lockstep_deadline_s, 0.001, 60.0);
   o.startup_timeout_s = p.number("startup_timeout_s", o.startup_timeout_s, 0.0, 3600.0);
   o.min_subscribers = p.integer("min_subscribers", o.min_subscribers, 0, 1000);
+  o.min_marker_subscribers = p.integer("min_marker_subscribers", o.min_marker_subscribers, 0, 1000);
   o.lost_after_missed_steps = p.integer("lost_after_missed_steps", o.lost_after_missed_steps, 1, 1000000);
   o.max_advisory_age_steps = p.integer("max_advisory_age_steps", o.max_advisory_age_steps, 0, 1000);
   o.v2x = params::loadChannelParams(p);

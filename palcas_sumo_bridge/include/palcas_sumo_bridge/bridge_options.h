@@ -71,6 +71,7 @@ struct BridgeOptions {
   double lockstep_deadline_s = 0.2;        ///< wall time an RSU has to answer a step [s]
   double startup_timeout_s = 30.0;         ///< wall time to wait for every RSU to register [s]
   int min_subscribers = 0;  ///< wait (up to startup_timeout_s) for this many vehicle_states subscribers
+  int min_marker_subscribers = 0;  ///< and for this many markers subscribers (the view's recorder)
   int lost_after_missed_steps = 50;        ///< consecutive misses before an RSU is lost
   int max_advisory_age_steps = 0;          ///< 0 = an advisory must answer the current step
   /// ~v2x/* (config/v2x.yaml): the V2X channel; the bridge applies the advisories' downlink

@@ -160,6 +160,7 @@ def build(scenario, arm, mode, pr, demand, ramp_demand, seed, duration_s, out_di
         b + "/advisory_control": bool(entry.get("advisory_control", False)), b + "/expected_rsus": rsu_ids,
         b + "/inprocess_rsus": True, b + "/real_time_factor": 0.0, b + "/rviz_template": "",
         b + "/trajectory_period_steps": int(tree.get(b + "/trajectory_period_steps", 0)), b + "/min_subscribers": 0,
+        b + "/min_marker_subscribers": 0,
         b + "/command_line": "palcas_env", b + "/git_commit": "unrecorded"})
     if demand is not None:
         tree[b + "/scenario/mainline_flow_vphpl"] = float(demand)
