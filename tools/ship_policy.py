@@ -24,6 +24,7 @@ DEST_DIR then is itself a policy folder for `./palcas run --policy` (train.json,
 checkpoints/fedserver/global_model.palcas or checkpoints/<rsu>/model.palcas) and carries
 TRAINING.md: command, commit, wall time, simulated hours, seeds, episodes."""
 import csv
+import filecmp
 import json
 import pathlib
 import shutil
@@ -44,6 +45,15 @@ def bridge_line(trained_with, runs_with, as_trained):
                 f"training did not use (trained under {trained})")
     return "- runs under config/bridge.yaml (trained under " + (
         f"`{pathlib.Path(trained_with).name}` over it" if trained_with else "it") + ")"
+
+
+def rsu_line(runs_with, trained_with):
+    """TRAINING.md's line on the RSU parameters the policy runs under (its rsu.yaml)."""
+    head = f"- its RSUs run under the parameters in `{pf.RSU_PARAMS}` (over config/departures.yaml)"
+    if trained_with and filecmp.cmp(runs_with, trained_with, shallow=False):
+        return f"{head}, the ones its training used (`{pathlib.Path(runs_with).name}`)"
+    trained = f"trained under `{pathlib.Path(trained_with).name}`" if trained_with else "trained without one"
+    return f"{head}, which its training did not use (`{pathlib.Path(runs_with).name}`; {trained})"
 
 
 def traffic_text(train):
@@ -160,8 +170,7 @@ def main(train_dir, dest, rsu_models=False, bridge_as_trained=False, run_bridge=
          if train["shipped_models"] == "rsu" else
          "- model: `checkpoints/fedserver/global_model.palcas` (the model every RSU loads)"),
         bridge_line(bridge, run_bridge, bridge_as_trained),
-        *([f"- its RSUs run under the parameters in `{pf.RSU_PARAMS}` (over config/departures.yaml), "
-           f"which its training did not use (`{pathlib.Path(run_rsu).name}`)"] if run_rsu else []),
+        *([rsu_line(run_rsu, repo_paths.usable(train.get("rsu_params", "")))] if run_rsu else []),
         "- files: "
         "`episodes.csv` (per-episode metrics), `learning_curves.png` / `.csv`, "
         "`checkpoints/<rsu>/learning.csv` (per-RSU learning rows)",

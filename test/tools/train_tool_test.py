@@ -451,7 +451,15 @@ class ShipPolicy(unittest.TestCase):
         self.assertEqual((dest / "rsu.yaml").read_text(), rsu.read_text())
         self.assertEqual(json.loads((dest / "train.json").read_text())["runs_with_rsu"], "rsu.yaml")
         self.assertIn("its RSUs run under the parameters in `rsu.yaml` (over config/departures.yaml), which its "
-                      "training did not use (`no_left_for_exit.yaml`)", (dest / "TRAINING.md").read_text())
+                      "training did not use (`no_left_for_exit.yaml`; trained without one)",
+                      (dest / "TRAINING.md").read_text())
+        # Trained under the same parameters: said so, not "did not use".
+        src = self.training("")
+        record = json.loads((src / "train.json").read_text())
+        (src / "train.json").write_text(json.dumps(dict(record, rsu_params=str(rsu))))
+        ship_policy.main(str(src), str(dest), rsu_models=True, run_rsu=str(rsu))
+        self.assertIn("(over config/departures.yaml), the ones its training used (`no_left_for_exit.yaml`)",
+                      (dest / "TRAINING.md").read_text())
         with self.assertRaises(SystemExit) as e:
             ship_policy.main(str(self.training("")), str(dest), run_rsu="/nonexistent.yaml")
         self.assertIn("--run-with-rsu: no such file /nonexistent.yaml", str(e.exception.code))
