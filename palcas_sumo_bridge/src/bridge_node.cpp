@@ -126,8 +126,8 @@ bool BridgeNode::waitForPeers() {
     const std::size_t rsu_nodes = inprocess_ ? 0 : options_.expected_rsus.size() - runner_->lockstep().unregistered().size();
     return static_cast<std::uint32_t>(options_.min_subscribers) + static_cast<std::uint32_t>(rsu_nodes);
   };
-  // The view's recorder (record.launch) is its own process: a late one missed the first
-  // markers and tf (on a loaded machine once the first 40 s of a 60 s episode).
+  // The view's recorder (record.launch) is its own process: one that connects late misses
+  // the first markers and tf (the journal, 2026-11-29).
   const auto markers_needed = static_cast<std::uint32_t>(options_.min_marker_subscribers);
   auto ready = [&] {
     return runner_->lockstep().allRegistered() && states_pub_.getNumSubscribers() >= subscribers_needed() &&

@@ -41,6 +41,12 @@ params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep out_dir:
 params="$(roslaunch --dump-params palcas_launch system.launch arm:=palcas_assist out_dir:=/tmp/unused 2>&1)"
 [ -n "$why" ] || grep -q '^/palcas_sumo_bridge/assist_mode: true' <<<"$params" || why="palcas_assist not in assist mode"
 [ -n "$why" ] || grep -q '^/rsu_0/rsu/federation: true' <<<"$params" || why="palcas_assist without federation"
+# Recording: the bridge waits for both recorders (states and the view's markers) before step 0.
+[ -n "$why" ] || grep -q '^/palcas_sumo_bridge/min_marker_subscribers: 0$' <<<"$params" || why="a markers subscriber awaited without recording"
+params="$(roslaunch --dump-params palcas_launch system.launch arm:=keep record:=true out_dir:=/tmp/unused 2>&1)"
+for expected in 'min_subscribers: 1' 'min_marker_subscribers: 1'; do
+  [ -n "$why" ] || grep -q "^/palcas_sumo_bridge/$expected\$" <<<"$params" || why="record:=true lacks '$expected'"
+done
 names+=(arm_parameters); failures+=("$why")
 if [ -z "$why" ]; then echo "ok   arm_parameters"; else echo "FAIL arm_parameters: $why"; fi
 

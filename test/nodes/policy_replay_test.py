@@ -78,8 +78,8 @@ class PolicyReplayTest(unittest.TestCase):
         cls.eval_dir = cls.tmp + "/eval_A"
         os.makedirs(cls.eval_dir)
         # 10x real time, not the recording default of 50x: rosbag record keeps 100 messages per
-        # topic and a loaded machine made it lose states at 50x (CI: 98.21 %; here once 306 of
-        # 601 steps). The bag that lost states is its own case below.
+        # topic, and on a loaded machine it loses states at 50x (the journal, 2026-11-29). The
+        # bag that lost states is its own case below.
         log = launch(cls.eval_dir, "mode:=eval", "seed:=11", "duration:=60", "record:=true", "real_time_factor:=10",
                      "policy_dir:=" + cls.policies["A"])
         cls.bag = cls.eval_dir + "/episode.bag"
