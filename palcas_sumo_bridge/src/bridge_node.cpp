@@ -140,13 +140,13 @@ bool BridgeNode::waitForPeers() {
     clock_pub_.publish(clock);
     ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.05));
   }
-  if (states_pub_.getNumSubscribers() < subscribers_needed())
-    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
-             states_pub_.getNumSubscribers(), subscribers_needed(), VEHICLE_STATES_TOPIC,
-             options_.startup_timeout_s);
-  if (markers_pub_.getNumSubscribers() < markers_needed)
-    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
-             markers_pub_.getNumSubscribers(), markers_needed, MARKERS_TOPIC, options_.startup_timeout_s);
+  auto warnIfShort = [&](const ros::Publisher& pub, std::uint32_t needed, const char* topic) {
+    if (pub.getNumSubscribers() < needed)
+      ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u expected subscribers of %s after %.1f s",
+                     pub.getNumSubscribers(), needed, topic, options_.startup_timeout_s);
+  };
+  warnIfShort(states_pub_, subscribers_needed(), VEHICLE_STATES_TOPIC);
+  warnIfShort(markers_pub_, markers_needed, MARKERS_TOPIC);
   if (runner_->lockstep().allRegistered()) return true;
   std::string missing;
   for (const std::string& id : runner_->lockstep().unregistered()) missing += " " + id;
