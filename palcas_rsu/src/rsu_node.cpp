@@ -19,6 +19,19 @@ namespace palcas::rsu {
 
 namespace {
 
+/// Subscribers of `topic` the master knows of. A publisher's own count covers only the
+/// links already made, so a wait for "every subscriber connected" needs this too: counting
+/// links alone, a recorder's could stand in for one still being made.
+uint32_t subscribersKnownToMaster(const std::string& topic) {
+  XmlRpc::XmlRpcValue request, response, payload;
+  request[0] = ros::this_node::getName();
+  if (!ros::master::execute("getSystemState", request, response, payload, false) || payload.size() < 2) return 0;
+  const XmlRpc::XmlRpcValue& subscribers = payload[1];
+  for (int i = 0; i < subscribers.size(); ++i)
+    if (static_cast<std::string>(subscribers[i][0]) == topic) return static_cast<uint32_t>(subscribers[i][1].size());
+  return 0;
+}
+
 /// The node's options with what they leave to the bridge's road filled in from it (the
 /// bridge sets it before opening registration; an RSU may start first, so wait for it).
 RsuNodeOptions loadOptionsOnTheRoad(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh) {
@@ -103,21 +116,10 @@ void RsuNode::waitForPeers() {
   const uint32_t links = peers + 1;
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
   // Every subscriber the master knows of (peers, and a recorder if any) must have connected
-  // to this RSU's publisher: counting peers alone, a recorder's link could stand in for a
-  // peer's that is still being made, and that peer would miss the first cluster states.
-  const std::string topic = cluster_pub_.getTopic();
-  auto known_subscribers = [&topic]() -> uint32_t {
-    XmlRpc::XmlRpcValue request, response, payload;
-    request[0] = ros::this_node::getName();
-    if (!ros::master::execute("getSystemState", request, response, payload, false) || payload.size() < 2)
-      return 0;
-    const XmlRpc::XmlRpcValue& subscribers = payload[1];
-    for (int i = 0; i < subscribers.size(); ++i)
-      if (static_cast<std::string>(subscribers[i][0]) == topic) return static_cast<uint32_t>(subscribers[i][1].size());
-    return 0;
-  };
+  // to this RSU's publisher, or a peer whose link is still being made misses the first
+  // cluster states.
   while (ros::ok() && ros::WallTime::now() < deadline &&
-         (cluster_pub_.getNumSubscribers() < std::max(links, known_subscribers()) ||
+         (cluster_pub_.getNumSubscribers() < std::max(links, subscribersKnownToMaster(cluster_pub_.getTopic())) ||
           cluster_sub_.getNumPublishers() < links))
     ros::WallDuration(0.02).sleep();
   if (cluster_pub_.getNumSubscribers() < links || cluster_sub_.getNumPublishers() < links)
@@ -141,7 +143,13 @@ void RsuNode::registerWithBridge() {
   // Registering starts the bridge's step 0: make sure its states reach us first.
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.register_timeout_s);
   // Its events too: a decision waits for its step's event array (DecisionInputs).
-  while (ros::ok() && (states_sub_.getNumPublishers() == 0 || events_sub_.getNumPublishers() == 0) &&
+  // And our answers must reach the bridge: one published before its link to us is made is
+  // lost, and the bridge waits out its lockstep deadline for it (the journal, 2026-11-29).
+  auto answers_connected = [this] {
+    return advisories_pub_.getNumSubscribers() >= std::max(1u, subscribersKnownToMaster(advisories_pub_.getTopic()));
+  };
+  while (ros::ok() && (states_sub_.getNumPublishers() == 0 || events_sub_.getNumPublishers() == 0 ||
+                       !answers_connected()) &&
          ros::WallTime::now() < deadline)
     ros::WallDuration(0.02).sleep();
   palcas_msgs::RegisterRsu srv;

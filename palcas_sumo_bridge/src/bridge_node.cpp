@@ -122,16 +122,21 @@ bool BridgeNode::waitForPeers() {
   // that RSU (with the V2X channel on, a missed early state changes what it hears at its
   // first decision). So wait for the bridge's side too: one link per RSU node, plus
   // min_subscribers (recorders, test nodes). In-process RSUs need no link.
-  auto subscribers_needed = [&] {
-    const std::size_t rsu_nodes = inprocess_ ? 0 : options_.expected_rsus.size() - runner_->lockstep().unregistered().size();
-    return static_cast<std::uint32_t>(options_.min_subscribers) + static_cast<std::uint32_t>(rsu_nodes);
+  auto rsu_nodes = [&] {
+    return static_cast<std::uint32_t>(
+        inprocess_ ? 0 : options_.expected_rsus.size() - runner_->lockstep().unregistered().size());
   };
+  auto subscribers_needed = [&] { return static_cast<std::uint32_t>(options_.min_subscribers) + rsu_nodes(); };
+  // And the way back: an RSU's first answer, published before the bridge's subscriber has
+  // connected to it, is lost, and the bridge waits out the whole lockstep deadline for it (a
+  // late step on a slow machine; the journal, 2026-11-29).
+  auto answer_links_ready = [&] { return advisories_sub_.getNumPublishers() >= rsu_nodes(); };
   // The view's recorder (record.launch) is its own process: one that connects late misses
   // the first markers and tf (the journal, 2026-11-29).
   const auto markers_needed = static_cast<std::uint32_t>(options_.min_marker_subscribers);
   auto ready = [&] {
     return runner_->lockstep().allRegistered() && states_pub_.getNumSubscribers() >= subscribers_needed() &&
-           markers_pub_.getNumSubscribers() >= markers_needed;
+           answer_links_ready() && markers_pub_.getNumSubscribers() >= markers_needed;
   };
   // Publish the clock so nodes on sim time can start; RSUs register once subscribed.
   rosgraph_msgs::Clock clock;
@@ -147,6 +152,9 @@ bool BridgeNode::waitForPeers() {
   };
   warnIfShort(states_pub_, subscribers_needed(), VEHICLE_STATES_TOPIC);
   warnIfShort(markers_pub_, markers_needed, MARKERS_TOPIC);
+  if (!answer_links_ready())
+    ROS_WARN_NAMED("startup", "palcas bridge: starting with %u of %u registered RSU nodes' %s connected after %.1f s",
+                   advisories_sub_.getNumPublishers(), rsu_nodes(), ADVISORIES_TOPIC, options_.startup_timeout_s);
   if (runner_->lockstep().allRegistered()) return true;
   std::string missing;
   for (const std::string& id : runner_->lockstep().unregistered()) missing += " " + id;

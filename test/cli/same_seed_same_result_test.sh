@@ -56,7 +56,11 @@ base_m = measured("first")
 if len(base_traj) < 1000: problems.append("first run recorded only %d trajectory rows" % len(base_traj))
 for r in runs:
     m = json.loads((folder(r) / "metrics.json").read_text())
-    if m.get("late_rsu_steps", 0): problems.append("%s: %s late RSU steps" % (r, m["late_rsu_steps"]))
+    if m.get("late_rsu_steps", 0):
+        # Which step and RSU: the bridge's warning, from the run's console or its log.
+        said = [line.strip() for f in (folder(r) / "console.log", work / (r + ".log")) if f.exists()
+                for line in f.read_text(errors="replace").splitlines() if "missed the" in line]
+        problems.append("%s: %s late RSU steps%s" % (r, m["late_rsu_steps"], " (" + said[0] + ")" if said else ""))
 for r in runs[1:]:
     if rows(folder(r) / "trajectories.csv") != base_traj: problems.append("%s: trajectories differ from the first run's" % r)
     if rows(folder(r) / "decisions.csv", drop=("decision_ms",)) != base_dec: problems.append("%s: decisions differ" % r)
