@@ -13,12 +13,14 @@ FOLDER/trial.json naming the settings (the keys of an experiment.json: arms, prs
 seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, git_commit,
 printed as they are; seeds_by_demand, {"1400": [seeds], ...}, for a part run with fewer seeds
 than the trial's list). Sections of their own, each from its key: federation {reference, arms}
-(the same training budget, another scheme), variants {arm: {base, what, ships}} (a learned arm's
-policy run another way; with ships true, the way the base arm's shipped policy now runs, which
-the targets read in place of the base's own rows), trainings {reference, arms: {arm: {seed, what}}, alternatives: {name:
-{what, arms}}} (the shipped configuration trained from other seeds; another configuration
-trained from several seeds, compared training by training), targets {key: value} (the learned
-advice's targets over TARGET_DEFAULTS). Without trial.json the grid is what the rows hold.
+(the same training budget, another scheme; reference_what describes the reference), variants
+{arm: {base, what, ships, replaced_as}} (a learned arm's policy run another way; with ships
+true, the way the base arm's shipped policy now runs, which the targets and the federation table
+read in place of the base's own rows; the federation table keeps those under replaced_as),
+trainings {reference, arms: {arm: {seed, what}}, alternatives: {name: {what, arms}},
+configuration} (the shipped configuration trained from other seeds, or the one `configuration`
+names; another configuration trained from several seeds, compared training by training),
+targets {key: value} (the learned advice's targets over TARGET_DEFAULTS). Without trial.json the grid is what the rows hold.
 
 The page: what was run (failed and missing points named); each arm's mechanisms (the
 registry config/arms.json and the bridge parameters it runs under: config/bridge.yaml, then
@@ -567,7 +569,7 @@ def what_was_run(rows, files, settings, folder, a):
             bad.append(f"`{arm}` {cell_short(cell)} s{seed}: {r['status']}" + (f" ({err})" if err else ""))
     lines.append("- Failed or missing points: " + ("none" if not bad else str(len(bad))))
     lines += [f"  - {b}" for b in bad]
-    fed_rows = [r for r in rows if r["arm"] in fed_arms]
+    fed_rows = [r for r in federation_rows(rows, settings) if r["arm"] in fed_arms]
     if fed_rows:
         lines.append(f"- The federation table: {len(fed_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sort_arms({r['arm'] for r in fed_rows}, load_registry()))
@@ -743,11 +745,33 @@ def shipped_variants(settings):
     return out
 
 
-def as_shipped(rows, shipped):
+def as_shipped(rows, shipped, replaced_as=None):
     """The rows with each shipping variant's rows standing for its base arm, whose own rows are
-    left out: a cell where the variant did not run has no rows of the base."""
+    left out (a cell where the variant did not run has no rows of the base), or kept under the
+    name `replaced_as` {base arm: name} gives them."""
     base_of = {variant: base for base, variant in shipped.items()}
-    return [dict(r, arm=base_of.get(r["arm"], r["arm"])) for r in rows if r["arm"] not in shipped]
+    replaced_as = replaced_as or {}
+    out = []
+    for r in rows:
+        if r["arm"] in shipped:
+            if r["arm"] in replaced_as:
+                out.append(dict(r, arm=replaced_as[r["arm"]]))
+        else:
+            out.append(dict(r, arm=base_of.get(r["arm"], r["arm"])))
+    return out
+
+
+def federation_rows(rows, settings):
+    """The rows the federation table reads. Its reference is the shipped federation: when a
+    variant ships as the reference arm, the variant's rows stand for it, and the rows the trial
+    ran of the reference are kept under the variant's `replaced_as` name (to be listed among the
+    table's arms as the policy that shipped before)."""
+    shipped = shipped_variants(settings)
+    ref = federation_reference(settings)
+    if ref not in shipped:
+        return rows
+    replaced = (variant_arms(settings)[shipped[ref]].get("replaced_as") or "").strip()
+    return as_shipped(rows, {ref: shipped[ref]}, {ref: replaced} if replaced else None)
 
 
 def training_arms(settings):
@@ -787,6 +811,10 @@ def analyse_federation(rows, settings, a):
     arms, ref = federation_arms(settings), federation_reference(settings)
     if not arms:
         return []
+    rows = federation_rows(rows, settings)
+    shipped = shipped_variants(settings)
+    reference_what = ((settings.get("federation") or {}).get("reference_what")
+                      or "each RSU its own final model, trained through FedAvg")
     best = {x["cell"]: x["best"] for x in a["cells"]}
     out = []
     for cell in cells_of([r for r in rows if r["arm"] in arms]):
@@ -796,7 +824,8 @@ def analyse_federation(rows, settings, a):
                 entries.append(dict(paired_entry(rows, cell, ref, arm, FEDERATION_METRICS, best.get(cell)),
                                     arm=arm, what=arms[arm]))
         out.append({"cell": cell, "reference": ref, "reference_own": arm_cell(rows, ref, cell),
-                    "best": best.get(cell), "entries": entries})
+                    "best": best.get(cell), "entries": entries, "reference_what": reference_what,
+                    "reference_rows_of": shipped.get(ref, ref)})
     return out
 
 
@@ -934,6 +963,7 @@ def analyse_trainings(rows, settings, a):
                     "dsr": sum(e["dsr"] for e in entries) / len(entries),
                     "lane_changes": sum(e["lane_changes"] for e in entries) / len(entries),
                     "alternatives": alts,
+                    "configuration": ((settings.get("trainings") or {}).get("configuration") or "").strip(),
                     "control_dsr": (ctrl_own.get("dsr") or {}).get("mean", float("nan")),
                     "control_lane_changes": (ctrl_own.get("lane_changes_per_cav") or {}).get("mean", float("nan"))})
     return out
@@ -955,6 +985,8 @@ def trainings_section(tr):
              f"(trial.json's trainings alternatives) is compared with the training as the unit: its trainings' "
              f"mean against the shipped trainings' mean, with the Welch 95 % interval over the trainings' "
              f"means (a configuration with one training has no such interval and is shown only as a variant)."]
+    if tr[0]["configuration"]:  # trainings of a configuration that no longer ships, say
+        lines += ["", f"**The configuration these trainings are of:** {tr[0]['configuration']}"]
     for x in tr:
         lines += ["", f"### {cell_title(x['cell'])}, against `{x['control']}`", ""]
         for e in x["entries"]:
@@ -1075,9 +1107,10 @@ def comparison_rows(d, pr, comparisons):
 def federation_section(fed):
     if not fed:
         return []
-    ref = fed[0]["reference"]
+    ref, rows_of = fed[0]["reference"], fed[0]["reference_rows_of"]
+    read_as = "" if rows_of == ref else f"; its rows are those of the variant `{rows_of}`, as it ships"
     lines = ["", "## The federation against its alternatives, same training budget", "",
-             f"`{ref}` (the shipped federation: each RSU its own final model, trained through FedAvg) "
+             f"`{ref}` (the shipped federation: {fed[0]['reference_what']}{read_as}) "
              "against policies trained with the same budget (episodes, durations, demand and PR draws, "
              "actuation) but another scheme, on the same seeds, paired as above: "
              f"`{ref}` − the other, and speed as `{ref}` ÷ the other − 1. Each is also paired with the "

@@ -247,6 +247,35 @@ class FederationTest(unittest.TestCase):
         self.assertIn("- `independent`: no federation, same budget", page)
         self.assertIn("| `palcas` vs `independent` | DSR", page)
 
+    def test_a_reference_that_ships_as_a_variant_reads_the_variants_rows(self):
+        # palcas now ships as palcas_heads (faster by 2 % on LOW's seeds): the table's palcas is
+        # palcas_heads, and the rows the trial ran of palcas stay in it as palcas_before.
+        for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            self.rows.append(dict(r, arm="palcas_heads", point=r["point"].replace("palcas", "palcas_heads"),
+                                  **{SPEED: repr(float(r[SPEED]) * 1.02)}))
+        self.settings["variants"] = {"palcas_heads": {"base": "palcas", "what": "heads", "ships": True,
+                                                      "replaced_as": "palcas_before"}}
+        self.settings["federation"] = {"reference_what": "a shared body under per-zone heads",
+                                       "arms": {"independent": "alone", "palcas_before": "shipped before"}}
+        a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+        fed = trial_results.analyse_federation(self.rows, self.settings, a)
+        [x] = [x for x in fed if x["cell"] == LOW]
+        self.assertEqual((x["reference"], x["reference_rows_of"]), ("palcas", "palcas_heads"))
+        before = [e for e in x["entries"] if e["arm"] == "palcas_before"][0]
+        self.assertAlmostEqual(before["ratio"]["mean"], 2.0, places=6)
+        self.assertEqual(trial_results.verdict(before["ratio"]), "gain")
+        page = "\n".join(trial_results.federation_section([x]))
+        self.assertIn("`palcas` (the shipped federation: a shared body under per-zone heads; its rows are "
+                      "those of the variant `palcas_heads`, as it ships)", page)
+        self.assertIn("| `palcas` vs `palcas_before` | speed ratio", page)
+        lines = trial_results.what_was_run(self.rows, [FIXTURE / "results.csv"], self.settings, FIXTURE, a)
+        self.assertIn("- The federation table: 9 rows of `independent`, `palcas_before` (9 finished), against "
+                      "`palcas`'s own points", lines)
+        # Without replaced_as the rows the trial ran of palcas are left out of the table.
+        del self.settings["variants"]["palcas_heads"]["replaced_as"]
+        [x] = trial_results.analyse_federation(self.rows, self.settings, a)
+        self.assertEqual((x["cell"], [e["arm"] for e in x["entries"]]), (LOW, ["independent"]))
+
     def test_its_rows_are_counted_not_listed_as_outside_the_grid(self):
         a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
         lines = trial_results.what_was_run(self.rows, [FIXTURE / "results.csv"], self.settings, FIXTURE, a)
