@@ -969,6 +969,12 @@ def analyse_trainings(rows, settings, a):
     return out
 
 
+def configuration_name(x):
+    """What the retrainings' reference configuration is called: the shipped one, unless
+    trial.json's trainings configuration says they are of another."""
+    return "the reference configuration" if x.get("configuration") else "the shipped configuration"
+
+
 def trainings_section(tr):
     if not tr:
         return []
@@ -1010,14 +1016,14 @@ def trainings_section(tr):
             if alt["what"]:
                 lines += [alt["what"], ""]
             lines += training_table(alt["entries"], x["control"])
-            lines += ["", f"- `{alt['name']}` against the shipped configuration, the training as the unit "
+            lines += ["", f"- `{alt['name']}` against {configuration_name(x)}, the training as the unit "
                       f"({len(alt['entries'])} against {len(x['entries'])} trainings, their means over the same "
                       f"{len(x['seeds'])} seeds): {fmt(alt['mean_of_means'], 2, signed=True)} % against "
                       f"{fmt(x['mean_of_means'], 2, signed=True)} % vs `{x['control']}`, a difference of "
                       f"{fmt(alt['diff'], 2, signed=True)} points, Welch 95 % {interval(alt['lo'], alt['hi'], 2)}: "
                       f"{WORDS[alt['verdict']]}",
-                      f"- Between its trainings: SD {fmt(alt['between_sd'], 2)} points (the shipped "
-                      f"configuration's: {fmt(x['between_sd'], 2)}); mean DSR {fmt(alt['dsr'], 1)} % against "
+                      f"- Between its trainings: SD {fmt(alt['between_sd'], 2)} points "
+                      f"({configuration_name(x)}'s: {fmt(x['between_sd'], 2)}); mean DSR {fmt(alt['dsr'], 1)} % against "
                       f"{fmt(x['dsr'], 1)} %, lane changes per CAV {fmt(alt['lane_changes'], 2)} against "
                       f"{fmt(x['lane_changes'], 2)}"]
     return lines
@@ -1048,7 +1054,7 @@ def trainings_csv(tr):
         for alt in x["alternatives"]:
             rows += [[d, pr, e["arm"], e["seed"], x["control"], e["n"], e["mean"], e["lo"], e["hi"], e["sd"],
                       e["worst"], e["worst_seed"], e["dsr"], e["lane_changes"]] for e in alt["entries"]]
-            rows.append([d, pr, f"{alt['name']} minus the shipped configuration (Welch, trainings)", "",
+            rows.append([d, pr, f"{alt['name']} minus {configuration_name(x)} (Welch, trainings)", "",
                          x["control"], len(x["seeds"]), alt["diff"], alt["lo"], alt["hi"], alt["between_sd"],
                          "", "", alt["dsr"] - x["dsr"], alt["lane_changes"] - x["lane_changes"]])
     return csv_text(head, rows)
