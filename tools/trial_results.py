@@ -17,9 +17,10 @@ than the trial's list). Sections of their own, each from its key: federation {re
 {arm: {base, what, ships, replaced_as}} (a learned arm's policy run another way; with ships
 true, the way the base arm's shipped policy now runs, which the targets and the federation table
 read in place of the base's own rows; the federation table keeps those under replaced_as),
-trainings {reference, arms: {arm: {seed, what}}, alternatives: {name: {what, arms}},
+trainings {reference, arms: {arm: {seed, what}}, alternatives: {name: {what, arms, against}},
 configuration} (the shipped configuration trained from other seeds, or the one `configuration`
-names; another configuration trained from several seeds, compared training by training),
+names; another configuration trained from several seeds, compared training by training with
+the shipped one, or with the alternative `against` names),
 targets {key: value} (the learned advice's targets over TARGET_DEFAULTS). Without trial.json the grid is what the rows hold.
 
 The page: what was run (failed and missing points named); each arm's mechanisms (the
@@ -785,10 +786,18 @@ def training_reference(settings):
 
 
 def training_alternatives(settings):
-    """{name: {"what": text, "arms": {arm: {"seed", "what"}}}} of trial.json's trainings: another
-    configuration (an update schedule, say) trained from several seeds, compared with the
-    shipped configuration's trainings, the training being the unit."""
-    return dict((settings.get("trainings") or {}).get("alternatives") or {})
+    """{name: {"what": text, "arms": {arm: {"seed", "what"}}, "against": name}} of trial.json's
+    trainings: another configuration (an update schedule, say) trained from several seeds,
+    compared with the shipped configuration's trainings, the training being the unit, or with
+    the alternative its "against" names (one that differs from it in one setting)."""
+    alternatives = dict((settings.get("trainings") or {}).get("alternatives") or {})
+    for name, alt in alternatives.items():
+        against = alt.get("against")
+        if against is not None and (against == name or against not in alternatives
+                                    or alternatives[against].get("against") is not None):
+            raise TrialError(f"trial.json trainings: alternative '{name}' is against '{against}', "
+                             f"which is not another alternative compared with the shipped configuration")
+    return alternatives
 
 
 def alternative_arms(settings):
@@ -943,19 +952,30 @@ def analyse_trainings(rows, settings, a):
         means = [e["mean"] for e in entries]
         within = math.sqrt(sum(e["sd"] ** 2 for e in entries) / len(entries)) if entries else float("nan")
         n = len(common)
-        alts = []
+        alts, by_name = [], {}
         for name, have in alt_present.items():
             info = alternatives[name]
             alt_entries = [training_entry(rows, cell, x, info["arms"][x], by_arm[x], ctrl, common) for x in have]
             alt_means = [e["mean"] for e in alt_entries]
-            diff, lo, hi = welch_interval(alt_means, means)
-            alts.append({"name": name, "what": info.get("what", ""), "entries": alt_entries,
-                         "mean_of_means": sum(alt_means) / len(alt_means), "between_sd": stdev(alt_means),
-                         "diff": diff, "lo": lo, "hi": hi,
-                         "verdict": "none" if not (math.isfinite(lo) and (lo > 0 or hi < 0))
-                         else ("gain" if lo > 0 else "loss"),
-                         "dsr": sum(e["dsr"] for e in alt_entries) / len(alt_entries),
-                         "lane_changes": sum(e["lane_changes"] for e in alt_entries) / len(alt_entries)})
+            by_name[name] = {"name": name, "what": info.get("what", ""), "entries": alt_entries,
+                             "against": info.get("against"), "means": alt_means,
+                             "mean_of_means": sum(alt_means) / len(alt_means), "between_sd": stdev(alt_means),
+                             "dsr": sum(e["dsr"] for e in alt_entries) / len(alt_entries),
+                             "lane_changes": sum(e["lane_changes"] for e in alt_entries) / len(alt_entries)}
+        for name, alt in by_name.items():
+            base = by_name.get(alt["against"]) if alt["against"] else None
+            if alt["against"] and base is None:
+                continue  # what it is compared with has fewer than two trainings in this cell
+            diff, lo, hi = welch_interval(alt["means"], base["means"] if base else means)
+            alts.append(dict(alt, diff=diff, lo=lo, hi=hi,
+                             verdict="none" if not (math.isfinite(lo) and (lo > 0 or hi < 0))
+                             else ("gain" if lo > 0 else "loss"),
+                             base_mean=base["mean_of_means"] if base else sum(means) / len(means),
+                             base_sd=base["between_sd"] if base else stdev(means),
+                             base_n=len(base["entries"]) if base else len(entries),
+                             base_dsr=base["dsr"] if base else sum(e["dsr"] for e in entries) / len(entries),
+                             base_lane_changes=(base["lane_changes"] if base else
+                                                sum(e["lane_changes"] for e in entries) / len(entries))))
         out.append({"cell": cell, "control": control, "reference": ref, "seeds": common, "entries": entries,
                     "between_sd": stdev(means), "between_range": (min(means), max(means)),
                     "mean_of_means": sum(means) / len(means), "within_sd": within,
@@ -969,9 +989,12 @@ def analyse_trainings(rows, settings, a):
     return out
 
 
-def configuration_name(x):
-    """What the retrainings' reference configuration is called: the shipped one, unless
-    trial.json's trainings configuration says they are of another."""
+def configuration_name(x, alt=None):
+    """What an alternative is compared with: the alternative its "against" names, else the
+    retrainings' reference configuration, called the shipped one unless trial.json's trainings
+    configuration says they are of another."""
+    if alt is not None and alt.get("against"):
+        return f"`{alt['against']}`"
     return "the reference configuration" if x.get("configuration") else "the shipped configuration"
 
 
@@ -989,7 +1012,8 @@ def trainings_section(tr):
              f"between two trained policies smaller than the spread between trainings of one "
              f"configuration is not a difference between their configurations. So another configuration "
              f"(trial.json's trainings alternatives) is compared with the training as the unit: its trainings' "
-             f"mean against the shipped trainings' mean, with the Welch 95 % interval over the trainings' "
+             f"mean against the shipped trainings' mean (or those of the alternative it is named against), "
+             f"with the Welch 95 % interval over the trainings' "
              f"means (a configuration with one training has no such interval and is shown only as a variant)."]
     if tr[0]["configuration"]:  # trainings of a configuration that no longer ships, say
         lines += ["", f"**The configuration these trainings are of:** {tr[0]['configuration']}"]
@@ -1016,16 +1040,17 @@ def trainings_section(tr):
             if alt["what"]:
                 lines += [alt["what"], ""]
             lines += training_table(alt["entries"], x["control"])
-            lines += ["", f"- `{alt['name']}` against {configuration_name(x)}, the training as the unit "
-                      f"({len(alt['entries'])} against {len(x['entries'])} trainings, their means over the same "
+            base = configuration_name(x, alt)
+            lines += ["", f"- `{alt['name']}` against {base}, the training as the unit "
+                      f"({len(alt['entries'])} against {alt['base_n']} trainings, their means over the same "
                       f"{len(x['seeds'])} seeds): {fmt(alt['mean_of_means'], 2, signed=True)} % against "
-                      f"{fmt(x['mean_of_means'], 2, signed=True)} % vs `{x['control']}`, a difference of "
+                      f"{fmt(alt['base_mean'], 2, signed=True)} % vs `{x['control']}`, a difference of "
                       f"{fmt(alt['diff'], 2, signed=True)} points, Welch 95 % {interval(alt['lo'], alt['hi'], 2)}: "
                       f"{WORDS[alt['verdict']]}",
                       f"- Between its trainings: SD {fmt(alt['between_sd'], 2)} points "
-                      f"({configuration_name(x)}'s: {fmt(x['between_sd'], 2)}); mean DSR {fmt(alt['dsr'], 1)} % against "
-                      f"{fmt(x['dsr'], 1)} %, lane changes per CAV {fmt(alt['lane_changes'], 2)} against "
-                      f"{fmt(x['lane_changes'], 2)}"]
+                      f"({base}'s: {fmt(alt['base_sd'], 2)}); mean DSR {fmt(alt['dsr'], 1)} % against "
+                      f"{fmt(alt['base_dsr'], 1)} %, lane changes per CAV {fmt(alt['lane_changes'], 2)} against "
+                      f"{fmt(alt['base_lane_changes'], 2)}"]
     return lines
 
 
@@ -1054,9 +1079,9 @@ def trainings_csv(tr):
         for alt in x["alternatives"]:
             rows += [[d, pr, e["arm"], e["seed"], x["control"], e["n"], e["mean"], e["lo"], e["hi"], e["sd"],
                       e["worst"], e["worst_seed"], e["dsr"], e["lane_changes"]] for e in alt["entries"]]
-            rows.append([d, pr, f"{alt['name']} minus {configuration_name(x)} (Welch, trainings)", "",
-                         x["control"], len(x["seeds"]), alt["diff"], alt["lo"], alt["hi"], alt["between_sd"],
-                         "", "", alt["dsr"] - x["dsr"], alt["lane_changes"] - x["lane_changes"]])
+            rows.append([d, pr, f"{alt['name']} minus {configuration_name(x, alt).strip('`')} (Welch, trainings)",
+                         "", x["control"], len(x["seeds"]), alt["diff"], alt["lo"], alt["hi"], alt["between_sd"],
+                         "", "", alt["dsr"] - alt["base_dsr"], alt["lane_changes"] - alt["base_lane_changes"]])
     return csv_text(head, rows)
 
 

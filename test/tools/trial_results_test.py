@@ -419,6 +419,44 @@ class TrainingsTest(unittest.TestCase):
         x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
         self.assertEqual(x["alternatives"], [], "one training has no spread to compare with")
 
+    def test_an_alternative_against_another_is_compared_with_that_ones_trainings(self):
+        self.add_alternative([0.90, 0.91, 0.89])
+        arms = {}
+        for i, factor in enumerate([0.80, 0.82]):
+            arm = f"palcas_alt2_s{i + 1}"
+            arms[arm] = {"seed": i + 1, "what": f"the other alternative from seed {i + 1}"}
+            for r in [r for r in self.rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+                self.rows.append(dict(r, arm=arm, point=r["point"].replace("palcas", arm),
+                                      **{SPEED: repr(float(r[SPEED]) * factor)}))
+        self.settings["trainings"]["alternatives"]["cheaper"] = {"what": "cheaper still", "arms": arms,
+                                                                 "against": "cheap"}
+        self.a = trial_results.analyse(self.rows, self.settings, trial_results.load_registry())
+        x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
+        by = {alt["name"]: alt for alt in x["alternatives"]}
+        cheap, cheaper = by["cheap"], by["cheaper"]
+        diff, lo, hi = trial_results.welch_interval(cheaper["means"], cheap["means"])
+        self.assertAlmostEqual(cheaper["diff"], diff)
+        self.assertAlmostEqual(cheaper["lo"], lo)
+        self.assertAlmostEqual(cheaper["base_mean"], cheap["mean_of_means"])
+        self.assertEqual(cheaper["base_n"], 3)
+        shipped = trial_results.welch_interval(cheap["means"], [e["mean"] for e in x["entries"]])
+        self.assertAlmostEqual(cheap["diff"], shipped[0], msg="the one without `against` stays on the shipped")
+        page = "\n".join(trial_results.trainings_section([x]))
+        self.assertIn("- `cheaper` against `cheap`, the training as the unit (2 against 3 trainings", page)
+        self.assertIn("- `cheap` against the shipped configuration, the training as the unit (3 against 3", page)
+        self.assertIn(',"cheaper minus cheap (Welch, trainings)",', trial_results.trainings_csv([x]))
+        # What it is compared with has one training in the cell: no comparison there.
+        self.rows = [r for r in self.rows if r["arm"] not in ("palcas_alt_s2", "palcas_alt_s3")]
+        x = trial_results.analyse_trainings(self.rows, self.settings, self.a)[0]
+        self.assertEqual(x["alternatives"], [])
+
+    def test_an_alternative_against_what_is_not_an_alternative_is_refused(self):
+        self.add_alternative([0.90, 0.91])
+        for against in ("cheap", "nonesuch"):
+            self.settings["trainings"]["alternatives"]["cheap"]["against"] = against
+            with self.assertRaisesRegex(trial_results.TrialError, f"alternative 'cheap' is against '{against}'"):
+                trial_results.analyse_trainings(self.rows, self.settings, self.a)
+
     def test_the_welch_interval(self):
         diff, lo, hi = trial_results.welch_interval([1.0, 2.0, 3.0], [4.0, 5.0, 6.0])
         # Equal variances 1, n 3 and 3: se sqrt(2/3), Welch df 4, t 2.776.
