@@ -577,6 +577,42 @@ class TargetsTest(unittest.TestCase):
         self.assertEqual(len(trial_results.targets_csv([row]).splitlines()), 2)
 
 
+class ApproachesTest(unittest.TestCase):
+    """trial.json's approaches: what was tried where a target is missed, quoted on the page with
+    the journal entry it comes from, which must exist."""
+
+    def setUp(self):
+        self.journal = pathlib.Path(tempfile.mkdtemp()) / "experiments.md"
+        self.journal.write_text("# Journal\n\n## A dwell between changes (dev)\n\ntext\n")
+        self.item = {"for": "item 2", "approach": "a dwell", "seeds": "dev 101-103",
+                     "outcome": "fewer lane changes, slower", "journal": "A dwell between changes (dev)"}
+
+    def tearDown(self):
+        shutil.rmtree(self.journal.parent, ignore_errors=True)
+
+    def test_each_approach_is_a_row_naming_its_journal_entry(self):
+        items = trial_results.approaches({"approaches": [self.item]}, self.journal)
+        page = "\n".join(trial_results.approaches_section(items))
+        self.assertIn("## What was tried where a target is missed", page)
+        self.assertIn("| item 2 | a dwell | dev 101-103 | fewer lane changes, slower | "
+                      "A dwell between changes (dev) |", page)
+        self.assertEqual(trial_results.approaches_section(trial_results.approaches({}, self.journal)), [])
+
+    def test_a_missing_field_or_journal_entry_is_named(self):
+        bad = dict(self.item, outcome=" ")
+        with self.assertRaisesRegex(trial_results.TrialError, r"approaches\[0\]: no outcome"):
+            trial_results.approaches({"approaches": [bad]}, self.journal)
+        bad = dict(self.item, journal="A dwell (renamed)")
+        with self.assertRaisesRegex(trial_results.TrialError, "journal heading 'A dwell \\(renamed\\)' is not in"):
+            trial_results.approaches({"approaches": [self.item, bad]}, self.journal)
+        with self.assertRaisesRegex(trial_results.TrialError, "approaches: not a list"):
+            trial_results.approaches({"approaches": {"x": 1}}, self.journal)
+
+    def test_the_committed_trial_names_only_journal_entries_that_exist(self):
+        settings = json.loads((trial_results.ROOT / "docs" / "trial" / "trial.json").read_text())
+        self.assertEqual(len(trial_results.approaches(settings)), len(settings.get("approaches") or []))
+
+
 class TrialRowsTest(unittest.TestCase):
     """tools/trial_rows.py: an experiment's rows of one arm added to the trial under another name,
     and nothing written when anything is wrong."""
