@@ -137,6 +137,8 @@ TEST(RsuOptions, BadValuesAreRefusedNamingTheKey) {
                 "rsu/no_left_for_exit_within_m");
   expectRefused("dwell", [](ros::NodeHandle& nh) { nh.setParam("rsu/lane_change_dwell_s", -1.0); },
                 "rsu/lane_change_dwell_s");
+  expectRefused("lane_change_cost", [](ros::NodeHandle& nh) { nh.setParam("rsu/lane_change_cost", -0.2); },
+                "rsu/lane_change_cost");
 }
 
 // The paper runs the federation's global model on every RSU; the shipped files (departures.yaml)

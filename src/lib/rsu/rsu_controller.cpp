@@ -60,6 +60,8 @@ void RsuControllerOptions::validate() const {
           no_left_for_exit_within_m, "must be finite and >= 0 (0 = off)");
   require(std::isfinite(lane_change_dwell_s) && lane_change_dwell_s >= 0.0, "lane_change_dwell_s",
           lane_change_dwell_s, "must be finite and >= 0 (0 = off)");
+  require(std::isfinite(lane_change_cost) && lane_change_cost >= 0.0, "lane_change_cost", lane_change_cost,
+          "must be finite and >= 0 (it is subtracted; 0 = off)");
   nested("rules", [&] { rules.validate(); });
   nested("terminal", [&] { validateTerminalRewards(terminal); });
   nested("reward", [&] { validateRewardParams(reward); });
@@ -229,6 +231,12 @@ ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane
   return allowed;
 }
 
+bool servesRoute(const VehicleSnapshot& vehicle, Action action) {
+  if (action == Action::kLaneLeft) return vehicle.lane < 1;
+  if (action == Action::kLaneRight) return std::isfinite(vehicle.distance_to_exit_m);
+  return true;
+}
+
 ActionMask RsuController::allowedFor(const VehicleSnapshot& vehicle, double time_s) const {
   return allowedActions(vehicle, options_.num_lanes, options_.no_left_for_exit_within_m) &
          dwellAllowedActions(vehicle, sinceLaneChange(vehicle, time_s), options_.lane_change_dwell_s);
@@ -378,6 +386,7 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
       p.decision = decisions[i];
       p.reward = obs.member_rewards[i];
       p.distance_to_exit_m = obs.member_exit_m[i];
+      p.cost = servesRoute(*obs.member_vehicles[i], decisions[i].action) ? 0.0 : options_.lane_change_cost;
     }
     book_.advance(obs.closings.vanished, std::move(decided));
   }

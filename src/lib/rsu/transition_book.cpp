@@ -76,7 +76,7 @@ namespace {
 Closure leftTheRoad(const std::string& id, const PendingDecision& p,
                     const TransitionOutcome& outcome, const TerminalRewards& terminal) {
   const TransitionReward r = palcas::leftTheRoad(p.lastReward(), outcome, terminal);
-  return Closure{id, p.state, p.valid_actions, r.reward, r.done};
+  return Closure{id, p.state, p.valid_actions, r.reward - p.cost, r.done};
 }
 
 // A CAV removed by an event (now or, from the limbo, since the last decision): collision /
@@ -123,7 +123,7 @@ Closings TransitionBook::close(const PendingFates& fates, const RoadIndex& road,
     const StateNow& s = stateNowOf(now, id);
     const TransitionReward r = palcas::stillOnTheRoad(p.periodReward(s.reward, over_period), done,
                                                       onRoadOutcome(p, v, events), terminal);
-    out.closures.push_back(Closure{id, s.state, s.valid_actions, r.reward, r.done});
+    out.closures.push_back(Closure{id, s.state, s.valid_actions, r.reward - p.cost, r.done});
   };
   // Last decision's vanished CAVs: their events have arrived by now.
   for (const auto& [id, p] : limbo_)

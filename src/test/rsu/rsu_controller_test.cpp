@@ -911,6 +911,67 @@ TEST(RsuController, ExitBoundCavsAreNotSentLeftWithinTheSetDistance) {
   palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "no_left_for_exit_within_m");
 }
 
+TEST(RsuController, ALaneChangeThatDoesNotServeTheRouteCostsItsTransition) {
+  using palcas::rsu::servesRoute;
+  VehicleSnapshot through = cav("t", 3, 1000.0), exiting = cav("x", 3, 1050.0);
+  exiting.distance_to_exit_m = 700.0;
+  const VehicleSnapshot merging = mergingCav("m", 850.0);
+  EXPECT_FALSE(servesRoute(through, Action::kLaneLeft));
+  EXPECT_FALSE(servesRoute(through, Action::kLaneRight));
+  EXPECT_FALSE(servesRoute(exiting, Action::kLaneLeft)) << "away from its exit";
+  EXPECT_TRUE(servesRoute(exiting, Action::kLaneRight));
+  EXPECT_TRUE(servesRoute(merging, Action::kLaneLeft)) << "the merge";
+  EXPECT_TRUE(servesRoute(through, Action::kAccelerate));
+  EXPECT_TRUE(servesRoute(through, Action::kKeep));
+
+  // The same two decisions with and without the cost: only the through CAV's change left and
+  // the exit-bound CAV's change left pay it, whichever way their transitions close.
+  const Decision left{Action::kLaneLeft, 0.0f}, right{Action::kLaneRight, 0.0f}, keep{Action::kKeep, 0.0f};
+  RsuControllerOptions o = smallOptions();
+  o.gradient_steps_per_decision = 0;
+  RsuController free_changes(o);
+  o.lane_change_cost = 0.5;
+  RsuController costly(o);
+  VehicleSnapshot away = exiting;
+  away.id = "y";
+  const RoadSnapshot first = road({through, exiting, away, merging});
+  const std::vector<Decision> advice{left, right, left, left};  // members in road order: t, x, y, m
+  VehicleSnapshot t2 = through, x2 = exiting;
+  t2.x_m += 20.0;
+  x2.x_m += 20.0;
+  const RoadSnapshot second = road({t2, x2, mergingCav("m", 870.0)});  // y vanished (not closed yet)
+  for (RsuController* c : {&free_changes, &costly}) {
+    c->adviseWith(first, 1, 0.1, GLOBAL, NONE, advice);
+  }
+  const palcas::rsu::DecisionView view = costly.preview(second, 2, 0.2, GLOBAL, NONE);
+  for (RsuController* c : {&free_changes, &costly}) {
+    c->adviseWith(second, 2, 0.2, GLOBAL, NONE, {keep, keep, keep});
+  }
+  const auto& paid = costly.agent().replay();
+  const auto& unpaid = free_changes.agent().replay();
+  ASSERT_EQ(paid.size(), 3u);  // m, t, x
+  ASSERT_EQ(unpaid.size(), 3u);
+  EXPECT_NEAR(paid.rewardAt(0), unpaid.rewardAt(0), 1e-6) << "the merge is free";
+  EXPECT_NEAR(paid.rewardAt(1), unpaid.rewardAt(1) - 0.5, 1e-6) << "the through CAV's change left";
+  EXPECT_NEAR(paid.rewardAt(2), unpaid.rewardAt(2), 1e-6) << "towards the exit is free";
+  ASSERT_EQ(view.closures.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(view.closures[i].reward, paid.rewardAt(i), 1e-6) << "preview = stored";
+  // y, gone from the road, closes at the next decision as having left it: it pays too.
+  for (RsuController* c : {&free_changes, &costly}) {
+    c->adviseWith(road({}), 3, 0.3, GLOBAL, NONE, {});
+  }
+  ASSERT_EQ(paid.size(), unpaid.size());
+  bool y_paid = false;
+  for (size_t i = 3; i < paid.size(); ++i)
+    y_paid = y_paid || std::abs(paid.rewardAt(i) - (unpaid.rewardAt(i) - 0.5f)) < 1e-6f;
+  EXPECT_TRUE(y_paid) << "an exit-bound CAV's change away from its exit costs, however it closes";
+
+  o.lane_change_cost = -0.1;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "lane_change_cost");
+  o.lane_change_cost = std::numeric_limits<double>::quiet_NaN();
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController bad(o); }, "lane_change_cost");
+}
+
 TEST(RsuController, ACavWhoseLaneJustChangedIsNotSentAcrossAgain) {
   using palcas::rsu::dwellAllowedActions;
   VehicleSnapshot through = cav("t", 3, 1000.0), exiting = cav("x", 3, 1000.0);

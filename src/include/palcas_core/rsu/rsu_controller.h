@@ -67,6 +67,11 @@ struct RsuControllerOptions {
   /// lane: such advice becomes KEEP, and in train mode the action is left out of its state's
   /// valid actions. The lane is seen at this RSU's decisions. >= 0 [s]; 0 (paper) = off.
   double lane_change_dwell_s = 0.0;
+  /// Subtracted from the reward of a transition whose advice was a lane change that does not
+  /// serve the CAV's route (anything but an exit-bound CAV's change right and the merge off
+  /// the acceleration lane): the speed-gain changes a policy makes too many of cost something,
+  /// so it learns which are worth it. Training only. >= 0, reward units; 0 (paper) = off.
+  double lane_change_cost = 0.0;
   /// Gradient steps per decide() call once the replay holds a batch (>= 0, finite);
   /// fractional credit accumulates (0.25 = one step every 4 calls).
   double gradient_steps_per_decision = 1.0;
@@ -163,6 +168,12 @@ ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double 
 /// acceleration lane (lane 0: its left change is the merge); otherwise no lane change but
 /// a right one of an exit-bound vehicle (finite distance_to_exit_m), towards its exit.
 ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane_change_s, double dwell_s);
+
+/// Whether advising `action` to the vehicle serves its route: a change right of an exit-bound
+/// vehicle (finite distance_to_exit_m), the merge from the acceleration lane (a left change
+/// from lane 0), and every action that is not a lane change. lane_change_cost charges the
+/// rest, as the bridge's guard refuses them in a busy zone.
+bool servesRoute(const VehicleSnapshot& vehicle, Action action);
 
 /// The controller's counters that a checkpoint carries beside the agent: one key of
 /// controller.txt each (the one list of the keys: rsu_controller_io.cpp; src/doc/rsu.md,

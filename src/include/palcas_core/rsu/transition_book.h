@@ -54,6 +54,8 @@ struct PendingDecision {
   Decision decision;
   double reward = 0.0;              ///< reward at that observation (for terminal transitions)
   double distance_to_exit_m = 0.0;  ///< at the decision; finite = its exit was ahead
+  double cost = 0.0;                ///< subtracted from the transition's reward, however it closes
+                                    ///< (RsuControllerOptions::lane_change_cost)
   double period_reward_sum = 0.0;   ///< rewards of the steps since (reward_over_period)
   int period_steps = 0;
 
