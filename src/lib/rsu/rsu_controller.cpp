@@ -224,17 +224,18 @@ ActionMask allowedActions(const VehicleSnapshot& vehicle, int num_lanes, double 
   return allowed;
 }
 
-ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane_change_s, double dwell_s) {
-  if (!(dwell_s > 0.0) || !(since_lane_change_s < dwell_s) || vehicle.lane < 1) return ALL_ACTIONS;
-  ActionMask allowed = ALL_ACTIONS & ~actionBit(Action::kLaneLeft);
-  if (!std::isfinite(vehicle.distance_to_exit_m)) allowed &= ~actionBit(Action::kLaneRight);
-  return allowed;
-}
-
 bool servesRoute(const VehicleSnapshot& vehicle, Action action) {
   if (action == Action::kLaneLeft) return vehicle.lane < 1;
   if (action == Action::kLaneRight) return std::isfinite(vehicle.distance_to_exit_m);
   return true;
+}
+
+ActionMask dwellAllowedActions(const VehicleSnapshot& vehicle, double since_lane_change_s, double dwell_s) {
+  if (!(dwell_s > 0.0) || !(since_lane_change_s < dwell_s) || vehicle.lane < 1) return ALL_ACTIONS;
+  ActionMask allowed = ALL_ACTIONS;
+  for (const Action change : {Action::kLaneLeft, Action::kLaneRight})
+    if (!servesRoute(vehicle, change)) allowed &= ~actionBit(change);
+  return allowed;
 }
 
 ActionMask RsuController::allowedFor(const VehicleSnapshot& vehicle, double time_s) const {
