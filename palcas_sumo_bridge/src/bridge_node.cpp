@@ -319,6 +319,7 @@ void BridgeNode::writeEpisode(int episode, const sim::EpisodeRun& run) {
   RunSummary summary;
   summary.episode = episode;
   summary.metrics = measure_->metrics().snapshot();
+  summary.exits = measure_->cavExits();
   summary.wall_seconds = run.wall_s;
   summary.steps = run.steps;
   summary.late_by_rsu = run.late_by_rsu;

@@ -336,6 +336,22 @@ json v2xJson(const BridgeOptions& o, const v2x::DownlinkCounts& d) {
           {"advice_mean_age_s", number(d.meanAgeS())}};
 }
 
+json exitsJson(const std::vector<metrics::ExitTally>& exits) {
+  // The pooled DSR hides a zone that lets its exits pass while the others serve theirs.
+  json out = json::array();
+  for (std::size_t k = 0; k < exits.size(); ++k) {
+    const metrics::ExitTally& e = exits[k];
+    out.push_back({{"cluster", k},
+                   {"exit_bound_cavs", e.exitBound()},
+                   {"served", e.served},
+                   {"missed", e.missed},
+                   {"lost", e.lost},
+                   {"censored", e.censored},
+                   {"served_pct", number(e.servedPct())}});
+  }
+  return out;
+}
+
 void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) {
   const metrics::EpisodeMetrics& m = s.metrics;
   json timing = json::array();
@@ -362,6 +378,7 @@ void writeMetricsJson(const BridgeOptions& o, const RunSummary& s, int episode) 
               {"efficiency_steady_mps", number(m.efficiency_steady_mps)},
               {"exiting_cavs_censored", m.exiting_cavs_censored},
               {"dsr_censored_pct", number(m.dsr_censored_pct)},
+              {"exits_by_cluster", exitsJson(s.exits)},
               {"merging_cavs_censored", m.merging_cavs_censored},
               {"msr_censored_pct", number(m.msr_censored_pct)},
               {"mean_travel_time_s", number(m.mean_travel_time_s)},

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -105,6 +106,7 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
 
   std::map<std::string, Measured> measured;
   metrics::EpisodeMetrics m;
+  std::vector<metrics::ExitTally> exits;
   MeasureRules rules;
   {
     sim::SumoSession session(sessionOptionsFor(o, sumocfg, 0));
@@ -131,6 +133,7 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
       measured[v.id].lane_at_end = v.edge + "_" + std::to_string(v.sumo_lane_index);
     }
     m = measure.metrics().snapshot();
+    exits = measure.cavExits();
   }  // SUMO closes: the tripinfo file is complete
 
   // What SUMO drove: routes and flows, the network's connections, the trips it finished.
@@ -164,6 +167,9 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
     if (!agrees && disagree.size() < 12) disagree.push_back(id + ": " + what);
   };
   std::set<std::string> finished, ramps_taken;
+  // Per exit (cluster of the route's off-ramp): served by SUMO's account, and still open.
+  std::map<int, std::size_t> served_by_exit, censored_by_exit;
+  auto exitOf = [&](const std::vector<std::string>& route) { return rules.off_ramp_edges.at(route.back()); };
   for (auto& t : elements(slurp(o.out_dir + "/sumo_tripinfo.xml"), "tripinfo")) {
     const std::string& id = t["id"];
     finished.insert(id);
@@ -180,6 +186,7 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
         check(!ok, id, "removed (" + t["vaporized"] + ") before its exit, measured as taken");
       } else if (arrived_on == route.back()) {
         ++exit_ok;
+        ++served_by_exit[exitOf(route)];
         ramps_taken.insert(arrived_on);
         check(ok && !missed, id, "arrived on its off-ramp " + route.back() + ", measured " +
                                      (missed ? "missed" : "undecided"));
@@ -211,6 +218,8 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
       exit_ok_on_road += ok;
       exit_decided_on_road += ok || missed;
       exit_censored += !ok && !missed;
+      served_by_exit[exitOf(route)] += ok;
+      censored_by_exit[exitOf(route)] += !ok && !missed;
       check(ok == sumo_on_ramp && !missed, id,
             "on " + lane + " at the end, measured " + (ok ? "taken" : missed ? "missed" : "undecided"));
     }
@@ -245,6 +254,14 @@ TEST(OwnRoadOutcomes, DsrAndMsrAgreeWithSumosTripinfo) {
   EXPECT_EQ(m.merges_ok, static_cast<std::uint64_t>(merged + merged_on_road));
   EXPECT_EQ(m.merging_cavs, static_cast<std::uint64_t>(merged + merge_removed + merged_on_road));
   EXPECT_EQ(m.merging_cavs_censored, static_cast<std::uint64_t>(merge_censored));
+  // Each exit's tally is SUMO's account of that exit's CAVs (the three with an off-ramp).
+  ASSERT_EQ(exits.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(exits[k].served, served_by_exit[k]) << "exit " << k;
+    EXPECT_EQ(exits[k].censored, censored_by_exit[k]) << "exit " << k;
+  }
+  EXPECT_EQ(std::count_if(served_by_exit.begin(), served_by_exit.end(), [](const auto& e) { return e.second > 0; }),
+            3) << "exits whose CAVs SUMO delivered";
   // SUMO-native drives every CAV along its route: tripinfo has every arrived exit on its ramp.
   EXPECT_EQ(exit_missed, 0);
   EXPECT_DOUBLE_EQ(m.dsr_pct, 100.0 * m.exits_ok / m.exiting_cavs);

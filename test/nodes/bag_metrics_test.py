@@ -53,6 +53,9 @@ class BagMetricsTest(unittest.TestCase):
         self.assertGreater(live["arrived"], 10)
         self.assertGreater(live["mean_travel_time_s"], 0.0)
         self.assertEqual(recomputed["arrived"], live["arrived"])
+        # Each exit's tally too (compared exactly above), and some exit-bound CAV in it.
+        self.assertEqual(recomputed["exits_by_cluster"], live["exits_by_cluster"])
+        self.assertGreater(sum(e["exit_bound_cavs"] for e in live["exits_by_cluster"]), 0)
         self.assertIn("agree", check.stderr)
 
 

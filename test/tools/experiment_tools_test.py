@@ -32,6 +32,7 @@ import training_pace  # noqa: E402
 import ratio_by_demand  # noqa: E402
 import comfort_breakdown  # noqa: E402
 import lane_change_breakdown  # noqa: E402
+import exit_check  # noqa: E402
 import v2x_table  # noqa: E402
 from junit_runner import run_as_junit  # noqa: E402
 
@@ -785,6 +786,82 @@ class LaneChangeBreakdownTest(unittest.TestCase):
             self.assertEqual(lane_change_breakdown.main([str(d / "nowhere")]), 2)
             self.assertEqual(lane_change_breakdown.main([str(d), "--undone-within", "0"]), 2)
         self.assertIn("no trajectories.csv", err.getvalue())
+
+
+class ExitCheckTest(unittest.TestCase):
+    """tools/exit_check.py on hand-made metrics.json: each exit's CAVs pooled over seeds, the
+    worst seed found, a low exit failing --min-served-pct, a training's duplicate skipped, and
+    files that are not ours refused by name."""
+
+    def run_folder(self, root, point, arm, seed, exits, pr=60, demand=1000):
+        d = root / "points" / point / arm
+        d.mkdir(parents=True)
+        m = {"dsr_censored_pct": 0.0, "pr_percent": pr, "mainline_flow_vphpl": demand, "seed": seed,
+             "exits_by_cluster": [dict(zip(("served", "missed", "lost", "censored"), e), cluster=k)
+                                  for k, e in enumerate(exits)]}
+        (d / "metrics.json").write_text(json.dumps(m))
+        return d
+
+    def setUp(self):
+        self.root = pathlib.Path(tempfile.mkdtemp(prefix="palcas_exitcheck_"))
+        self.addCleanup(shutil.rmtree, self.root, True)
+        # Exit 1 served 9 of 10 on seed 101 and 1 of 10 on seed 102; exit 3 has no off-ramp.
+        self.run_folder(self.root, "palcas_s101", "palcas", 101,
+                        [(10, 0, 0, 0), (9, 1, 0, 0), (20, 0, 0, 0), (0, 0, 0, 0)])
+        self.run_folder(self.root, "palcas_s102", "palcas", 102,
+                        [(10, 0, 0, 0), (1, 7, 1, 1), (19, 1, 0, 0), (0, 0, 0, 0)])
+        self.run_folder(self.root, "keep_s101", "keep", 101,
+                        [(5, 0, 0, 0), (5, 0, 0, 0), (5, 0, 0, 0), (0, 0, 0, 0)])
+
+    def test_pools_each_exit_over_seeds_and_names_the_worst_seed(self):
+        rows = {(r[0], r[3]): r for r in exit_check.check([self.root])}
+        self.assertNotIn(("palcas", 3), rows)  # no exit-bound CAV: no row
+        arm, pr, demand, k, runs, pooled, pct, worst, seed = rows[("palcas", 1)]
+        self.assertEqual((pr, demand, runs), (60, 1000, 2))
+        self.assertEqual(pooled, {"served": 10, "missed": 8, "lost": 1, "censored": 1})
+        self.assertAlmostEqual(pct, 50.0)  # censored and lost count as not served
+        self.assertEqual((worst, seed), (10.0, 102))
+        self.assertAlmostEqual(rows[("palcas", 2)][6], 97.5)
+        self.assertEqual(len(exit_check.check([self.root], arm="keep")), 3)
+
+    def test_min_served_pct_fails_on_the_low_exit_only(self):
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
+            self.assertEqual(exit_check.main([str(self.root), "--min-served-pct", "60"]), 1)
+        self.assertIn("palcas, PR 60 %, 1000 veh/h/lane: exit 1 served 50.0 %", err.getvalue())
+        self.assertEqual(err.getvalue().count("exit_check:"), 1)
+        out = self.root / "exits.csv"
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.assertEqual(exit_check.main([str(self.root), "--min-served-pct", "50", "--csv", str(out)]), 0)
+        self.assertEqual(len(list(csv.reader(out.open()))), 1 + 6)
+
+    def test_a_trainings_own_metrics_repeats_its_last_episode_and_is_skipped(self):
+        d = self.root / "train" / "palcas"
+        (d / "episode_0").mkdir(parents=True)
+        m = {"dsr_censored_pct": 0.0, "seed": 1, "exits_by_cluster": [
+            {"served": 1, "missed": 0, "lost": 0, "censored": 0}]}
+        (d / "episode_0" / "metrics.json").write_text(json.dumps(m))
+        (d / "metrics.json").write_text(json.dumps(m))
+        rows = exit_check.check([self.root / "train"])
+        self.assertEqual([(r[0], r[4]) for r in rows], [("palcas/episode_0", 1)])
+
+    def test_refuses_files_that_are_not_ours_and_bad_values(self):
+        bad = self.root / "other" / "x"
+        bad.mkdir(parents=True)
+        (bad / "metrics.json").write_text("{\"speed\": 3}")
+        with self.assertRaisesRegex(exit_check.ExitCheckError, "not a PALCAS run's metrics.json"):
+            exit_check.check([self.root / "other"])
+        (bad / "metrics.json").write_text("{\"dsr_censored_pct\": 90}")
+        with self.assertRaisesRegex(exit_check.ExitCheckError, "no exits_by_cluster"):
+            exit_check.check([self.root / "other"])
+        (bad / "metrics.json").write_text("not json")
+        with self.assertRaisesRegex(exit_check.ExitCheckError, "not readable as JSON"):
+            exit_check.check([self.root / "other"])
+        with self.assertRaisesRegex(exit_check.ExitCheckError, "no metrics.json of arm nobody"):
+            exit_check.check([self.root / "points"], arm="nobody")
+        with contextlib.redirect_stderr(io.StringIO()):
+            self.assertEqual(exit_check.main([str(self.root / "nowhere")]), 2)
+            with self.assertRaises(SystemExit):
+                exit_check.main([str(self.root), "--min-served-pct", "140"])
 
 
 class TrainingPaceTest(unittest.TestCase):

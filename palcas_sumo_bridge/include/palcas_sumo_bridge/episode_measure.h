@@ -42,6 +42,8 @@ class EpisodeMeasure {
 
   metrics::EpisodeMetricsAccumulator& metrics() { return metrics_; }
   const metrics::EpisodeMetricsAccumulator& metrics() const { return metrics_; }
+  /// Each exit's CAVs by outcome (the open ones censored), index = cluster.
+  std::vector<metrics::ExitTally> cavExits() const { return tracker_.cavExits(); }
 
  private:
   metrics::OutcomeTracker tracker_;

@@ -2,6 +2,7 @@
 // The run folder of one episode: the generated scenario, manifest.json (what ran: config
 // snapshot and hash, seeds, SUMO version, git commit, command line) and metrics.json.
 
+#include <nlohmann/json.hpp>
 #include <palcas_core/metrics/episode_metrics.h>
 
 #include <cstdint>
@@ -23,6 +24,7 @@ using StepTimer = sim::StepTimer;
 struct RunSummary {
   int episode = 0;
   metrics::EpisodeMetrics metrics;
+  std::vector<metrics::ExitTally> exits;  ///< per cluster: which zone's exits were served
   double wall_seconds = 0.0;
   std::uint64_t steps = 0;
   std::map<std::string, std::uint64_t> late_by_rsu;
@@ -67,6 +69,10 @@ void completeManifest(const BridgeOptions& options, const std::string& sumo_vers
 /// The measuring rules stored in a manifest.json. @throws std::runtime_error naming what
 /// is missing when the file is not a PALCAS manifest.
 MeasureRules readMeasureRules(const std::string& manifest_path);
+
+/// metrics.json's `exits_by_cluster`: per cluster its exit-bound CAVs by outcome and the share
+/// served (null without any), for the bridge and metrics_from_bag alike.
+nlohmann::json exitsJson(const std::vector<metrics::ExitTally>& exits);
 
 /// Writes the episode's metrics atomically (NaN as null) to <out_dir>/metrics.json, a row of
 /// <out_dir>/episodes.csv, and with several episodes <out_dir>/episode_<k>/metrics.json.

@@ -379,6 +379,7 @@ void ParallelEnvCore::endEpisode() {
   bridge::RunSummary summary;
   summary.episode = episode_;
   summary.metrics = measure_->metrics().snapshot();
+  summary.exits = measure_->cavExits();
   summary.wall_seconds = run.wall_s;
   summary.steps = run.steps;
   summary.late_by_rsu = run.late_by_rsu;

@@ -1,6 +1,7 @@
 #include "palcas_core/metrics/outcome_tracker.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <unordered_set>
 #include <utility>
@@ -33,6 +34,7 @@ OutcomeTracker::OutcomeTracker(OutcomeTrackerOptions options) : options_(std::mo
           "stop_speed_mps is ", options_.stop_speed_mps, ", must be >= 0");
   require(std::isfinite(options_.stop_window_m) && options_.stop_window_m >= 0.0, bad,
           "stop_window_m is ", options_.stop_window_m, ", must be >= 0");
+  cav_exits_.assign(options_.exit_x_m.size(), ExitTally{});
 }
 
 void OutcomeTracker::validateObservation(const VehicleObservation& obs) const {
@@ -141,8 +143,12 @@ void OutcomeTracker::decideMerge(const VehicleObservation& obs, Tracked& tracked
   events.push_back({obs.id, tracked.is_cav, kind, tracked.route_kind, obs.part_cluster, obs.x_m});
 }
 
+ExitTally& OutcomeTracker::exitTally(const Tracked& tracked) {
+  return cav_exits_[static_cast<std::size_t>(tracked.exit_cluster)];
+}
+
 void OutcomeTracker::decideExit(const VehicleObservation& obs, Tracked& tracked,
-                                std::vector<VehicleEvent>& events) const {
+                                std::vector<VehicleEvent>& events) {
   VehicleEventKind kind;
   if (obs.road_part == RoadPart::kOffRamp) {
     // On its own off-ramp: success. On another one: it left the mainline elsewhere, so it
@@ -150,12 +156,14 @@ void OutcomeTracker::decideExit(const VehicleObservation& obs, Tracked& tracked,
     const bool own = obs.part_cluster == tracked.exit_cluster;
     tracked.exit = own ? Outcome::kSucceeded : Outcome::kFailed;
     kind = own ? VehicleEventKind::kExitOk : VehicleEventKind::kExitMissed;
+    if (tracked.is_cav) ++(own ? exitTally(tracked).served : exitTally(tracked).missed);
   } else if (obs.road_part == RoadPart::kMainline &&
              obs.x_m > options_.exit_x_m[static_cast<std::size_t>(tracked.exit_cluster)] +
                            options_.miss_margin_m) {
     // Still on the mainline beyond x_exit + margin: it passed its off-ramp.
     tracked.exit = Outcome::kFailed;
     kind = VehicleEventKind::kExitMissed;
+    if (tracked.is_cav) ++exitTally(tracked).missed;
   } else {
     return;
   }
@@ -183,12 +191,29 @@ void OutcomeTracker::remove(const std::string& id, VehicleEventKind kind,
   if (routeHasExit(t.route_kind) && t.exit == Outcome::kUndecided &&
       kind == VehicleEventKind::kArrived)
     event(VehicleEventKind::kExitMissed);
+  if (t.is_cav && routeHasExit(t.route_kind) && t.exit == Outcome::kUndecided)
+    ++(kind == VehicleEventKind::kArrived ? exitTally(t).missed : exitTally(t).lost);
   event(kind);
   vehicles_.erase(it);
 }
 
+double ExitTally::servedPct() const {
+  const std::size_t bound = exitBound();
+  return bound == 0 ? std::numeric_limits<double>::quiet_NaN()
+                    : 100.0 * static_cast<double>(served) / static_cast<double>(bound);
+}
+
+std::vector<ExitTally> OutcomeTracker::cavExits() const {
+  std::vector<ExitTally> tally = cav_exits_;
+  for (const auto& [id, t] : vehicles_)
+    if (t.is_cav && routeHasExit(t.route_kind) && t.exit == Outcome::kUndecided)
+      ++tally[static_cast<std::size_t>(t.exit_cluster)].censored;
+  return tally;
+}
+
 void OutcomeTracker::reset() {
   vehicles_.clear();
+  cav_exits_.assign(options_.exit_x_m.size(), ExitTally{});
   ignored_removals_ = 0;
 }
 

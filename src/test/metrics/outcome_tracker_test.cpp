@@ -251,6 +251,51 @@ TEST(OutcomeTracker, TeleportIsCountedApartFromCollisions) {
   EXPECT_DOUBLE_EQ(m.dsr_pct, 0.0);
 }
 
+TEST(OutcomeTracker, TalliesEachExitsCavsByOutcomeAndSumsToTheEpisodesDsr) {
+  OutcomeTracker tracker(roadOptions());
+  EpisodeMetricsAccumulator metrics;
+  auto step = [&](const std::vector<VehicleObservation>& obs, const StepRemovals& removals) {
+    metrics.addEvents(tracker.update(obs, removals));
+  };
+  const auto exit = RouteKind::kMainExit;
+  step({onMainline("served0", true, exit, 0, 600.0), onMainline("passed1", true, exit, 1, 1400.0),
+        onMainline("elsewhere1", true, exit, 1, 600.0), onMainline("crash2", true, exit, 2, 2000.0),
+        onMainline("open2", true, exit, 2, 2100.0), onMainline("arrive2", true, exit, 2, 2200.0),
+        onMainline("human0", false, exit, 0, 650.0)},
+       {});
+  step({onPart("served0", true, exit, 0, RoadPart::kOffRamp, 0, 710.0),
+        onMainline("passed1", true, exit, 1, 1501.0),
+        onPart("elsewhere1", true, exit, 1, RoadPart::kOffRamp, 0, 710.0),
+        onMainline("open2", true, exit, 2, 2150.0),
+        onPart("human0", false, exit, 0, RoadPart::kOffRamp, 0, 710.0)},
+       {{"crash2"}, {}, {"arrive2"}});
+  const std::vector<ExitTally> exits = tracker.cavExits();
+  ASSERT_EQ(exits.size(), 3u);  // one per configured exit, a human driver in none
+  EXPECT_EQ(exits[0].served, 1u);
+  EXPECT_EQ(exits[0].exitBound(), 1u);
+  EXPECT_DOUBLE_EQ(exits[0].servedPct(), 100.0);
+  EXPECT_EQ(exits[1].missed, 2u);  // passed it on the mainline; left by exit 0's off-ramp
+  EXPECT_DOUBLE_EQ(exits[1].servedPct(), 0.0);
+  EXPECT_EQ(exits[2].lost, 1u);      // collided before its exit
+  EXPECT_EQ(exits[2].missed, 1u);    // arrived without being seen on its off-ramp
+  EXPECT_EQ(exits[2].censored, 1u);  // still before its exit
+  // The pooled figures the episode reports are these tallies summed.
+  const auto m = metrics.snapshot();
+  std::size_t served = 0, decided = 0, censored = 0;
+  for (const auto& e : exits) {
+    served += e.served;
+    decided += e.served + e.missed + e.lost;
+    censored += e.censored;
+  }
+  EXPECT_EQ(served, m.exits_ok);
+  EXPECT_EQ(decided, m.exiting_cavs);
+  EXPECT_EQ(censored, m.exiting_cavs_censored);
+  // reset() forgets the tallies with the vehicles.
+  tracker.reset();
+  for (const auto& e : tracker.cavExits()) EXPECT_EQ(e.exitBound(), 0u);
+  EXPECT_TRUE(std::isnan(tracker.cavExits()[0].servedPct()));
+}
+
 TEST(OutcomeTracker, RemovalListsAreDedupedCollisionFirst) {
   OutcomeTracker tracker(roadOptions());
   tracker.update({onMainline("a", true, RouteKind::kMainThrough, -1, 10.0)}, {});

@@ -52,6 +52,19 @@ struct OutcomeTrackerOptions {
   double stop_window_m = 10.0;
 };
 
+/// One exit's CAVs (those whose route ends on that cluster's off-ramp), by outcome. The
+/// episode's DSR pools every exit; this tells which RSU's zone lets its exit-bound CAVs pass.
+struct ExitTally {
+  std::size_t served = 0;    ///< EXIT_OK: seen on their own off-ramp
+  std::size_t missed = 0;    ///< EXIT_MISSED: passed it, left by another, or arrived without
+  std::size_t lost = 0;      ///< collided or teleported before their exit was decided
+  std::size_t censored = 0;  ///< still on the road with the exit open
+  std::size_t exitBound() const { return served + missed + lost + censored; }
+  /// 100 * served / exitBound(), the censored counted as not served (as dsr_censored_pct);
+  /// NaN with no exit-bound CAV.
+  double servedPct() const;
+};
+
 /// Per-vehicle outcome detector, deterministic in its inputs; memory bounded by the vehicles
 /// on the road (a vehicle is forgotten when it is removed). Not thread-safe.
 class OutcomeTracker {
@@ -78,7 +91,10 @@ class OutcomeTracker {
   std::size_t trackedVehicles() const { return vehicles_.size(); }
   /// Removal ids of vehicles never seen (or already forgotten) since construction / reset().
   std::size_t ignoredRemovals() const { return ignored_removals_; }
-  /// Forgets every vehicle and the ignored-removal count; keeps the options.
+  /// Per cluster (index = cluster, size = the configured exits): the CAVs bound for its
+  /// off-ramp since construction / reset(), the open ones as `censored`.
+  std::vector<ExitTally> cavExits() const;
+  /// Forgets every vehicle, the exit tallies and the ignored-removal count; keeps the options.
   void reset();
 
  private:
@@ -99,7 +115,8 @@ class OutcomeTracker {
   void validateObservation(const VehicleObservation& obs) const;
   void observe(const VehicleObservation& obs, std::vector<VehicleEvent>& events);
   void decideExit(const VehicleObservation& obs, Tracked& tracked,
-                  std::vector<VehicleEvent>& events) const;
+                  std::vector<VehicleEvent>& events);
+  ExitTally& exitTally(const Tracked& tracked);
   void decideMerge(const VehicleObservation& obs, Tracked& tracked,
                    std::vector<VehicleEvent>& events) const;
   void remove(const std::string& id, VehicleEventKind kind, std::vector<VehicleEvent>& events);
@@ -107,6 +124,7 @@ class OutcomeTracker {
   OutcomeTrackerOptions options_;
   std::unordered_map<std::string, Tracked> vehicles_;
   std::size_t ignored_removals_ = 0;
+  std::vector<ExitTally> cav_exits_;  ///< decided outcomes only; censored filled on query
 };
 
 }  // namespace palcas::metrics
