@@ -6,11 +6,10 @@ per arm, penetration rate and demand, pooled over the seeds with the worst seed 
 
 DIR: an experiment's output (its points/), a ./palcas run folder, or one arm's folder; every
 metrics.json below it is read (a training's top-level metrics.json, a copy of its last
-episode's, is skipped for its episode_<k>/ ones). The episode's DSR pools the exits; a policy
-whose one RSU lets its zone's exit-bound CAVs pass while the other two serve theirs can still
-report 90 % (a training of the shipped configuration served 74.7 % at light traffic, one zone
-letting 185 of its 268 pass: docs/journal/experiments.md). Served share counts the CAVs still
-before their exit at the end as not served, like dsr_censored_pct.
+episode's, is skipped for its episode_<k>/ ones). The episode's DSR pools the exits, so one
+RSU letting its zone's exit-bound CAVs pass while the others serve theirs hides in it (the
+case that led here: docs/journal/experiments.md). Served share counts the CAVs still before
+their exit at the end as not served, like dsr_censored_pct.
 
 --min-served-pct P: exit status 1, naming them, when an exit's pooled share in any cell is
 below P (the check before a training is counted or shipped: policies/palcas/TRAINING.md)."""
