@@ -310,6 +310,9 @@ def arm_cell(rows, arm, cell):
         vals = [(r["seed"], number(r.get(column))) for r in sel if number(r.get(column)) is not None]
         if vals:
             out["metrics"][key] = dict(summary(vals, better), column=column, fallback=fallback)
+    decided = [(r["seed"], number(r.get("dsr_pct"))) for r in sel if number(r.get("dsr_pct")) is not None]
+    if decided:
+        out["dsr_decided"] = summary(decided, "higher")
     k = n = 0
     derived = False
     for r in sel:
@@ -1232,10 +1235,15 @@ TARGET_DEFAULTS = {
     "light_demand": 1000,
     "advisory_arm": "palcas", "assist_arm": "palcas_assist",
     "assist_control": "rules_assist", "native_arm": "sumo_native",
-    "light_dsr_pct": 99.5,               # advisory mode's DSR (censored counted), at least
+    # DSR: of the CAVs whose exit was decided (dsr_pct), at least; and censored counted, at
+    # least this minus 100 points against native_arm's on the same seeds: CAVs still before
+    # their exit when a run ends are not served, so no arm, SUMO's own drivers included,
+    # reaches an absolute rate near 100 % on that count (docs/journal/experiments.md, "The
+    # DSR targets read as no arm could meet them").
+    "light_dsr_pct": 99.5,               # advisory mode's DSR, as above
     "light_lane_change_factor": 1.5,     # its lane changes per CAV ÷ SUMO-native's, at most
     "light_speed_floor_pct": -0.5,       # its speed ÷ best control − 1, at least
-    "assist_dsr_pct": 100.0,             # assist mode's DSR, at least
+    "assist_dsr_pct": 100.0,             # assist mode's DSR of the decided exits, at least
     "decision_p99_ms": 5.0,              # every run's decision p99, below
     "federation_reference": "palcas", "federation_control": "independent",
 }
@@ -1274,6 +1282,34 @@ def with_span(c, digits, unit=""):
         return f"{fmt(c['mean'], digits, signed=True)}{unit}"
     return (f"{fmt(c['mean'], digits, signed=True)}{unit} "
             f"[{fmt_bound(lo, digits, signed=True)}, {fmt_bound(hi, digits, signed=True)}]")
+
+
+def dsr_targets(mode, x, arm, least_pct, native, censored):
+    """A learned mode's DSR targets in cell x: of the CAVs whose exit was decided, at least
+    least_pct; with `censored`, also the rate that counts the CAVs still before their exit at
+    the end, at most 100 - least_pct points below `native`'s on the same seeds (an absolute
+    bar there is one SUMO's own drivers miss: the end of a run leaves exit-bound CAVs
+    undecided whoever drives). Each row names the other rate and native's beside it."""
+    own, ctl = x["arms"][arm], x["arms"].get(native) or {}
+    dsr, ctl_dsr = own["metrics"].get("dsr"), (ctl.get("metrics") or {}).get("dsr")
+    beside = (f"censored counted {fmt(dsr['mean'], 1)} %" if dsr else "")
+    if dsr and ctl_dsr:
+        beside += f", `{native}` {fmt(ctl_dsr['mean'], 1)} %"
+    out = []
+    decided = own.get("dsr_decided")
+    if decided:
+        out.append(target_row(f"{mode}: DSR of the decided exits", x["cell"], arm,
+                              f"{fmt(decided['mean'], 1)} %" + (f" ({beside})" if beside else ""),
+                              f"≥ {least_pct:g} %", decided["mean"] >= least_pct,
+                              f"{fmt(least_pct - decided['mean'], 1)} points below"))
+    e = comparison_of(x, arm, native)
+    if censored and e and dsr and ctl_dsr:
+        c, floor = metric_of(e, "dsr"), least_pct - 100.0
+        out.append(target_row(f"{mode}: DSR, censored counted, vs `{native}`", x["cell"], arm,
+                              f"{with_span(c, 1, ' points')} ({fmt(dsr['mean'], 1)} against "
+                              f"{fmt(ctl_dsr['mean'], 1)} %)", f"≥ {fmt(floor, 1, signed=True)} points (mean)",
+                              c["mean"] >= floor, f"{fmt(floor - c['mean'], 1)} points below"))
+    return out
 
 
 def analyse_targets(a, fed, settings, shipped=None):
@@ -1337,11 +1373,7 @@ def _targets(a, fed, t):
             adv = comparison_of(x, t["advisory_arm"], best)
             if adv and adv["ratio"]["n"] >= 2:
                 L = t["advisory_arm"]
-                dsr = x["arms"][L]["metrics"].get("dsr")
-                if dsr:
-                    out.append(target_row("advisory mode: DSR", cell, L, f"{fmt(dsr['mean'], 1)} %",
-                                          f"≥ {t['light_dsr_pct']:g} %", dsr["mean"] >= t["light_dsr_pct"],
-                                          f"{fmt(t['light_dsr_pct'] - dsr['mean'], 1)} points below"))
+                out += dsr_targets("advisory mode", x, L, t["light_dsr_pct"], t["native_arm"], censored=True)
                 lc = x["arms"][L]["metrics"].get("lane_changes_per_cav")
                 native = (x["arms"].get(t["native_arm"]) or {}).get("metrics", {}).get("lane_changes_per_cav")
                 if lc and native and native["mean"] > 0:
@@ -1359,11 +1391,7 @@ def _targets(a, fed, t):
                 L, c = t["assist_arm"], assist["ratio"]
                 out.append(target_row(f"assist mode: speed vs `{t['assist_control']}`", cell, L, with_span(c, 2, " %"),
                                       "≥ 0 % (mean)", c["mean"] >= 0.0, f"{fmt(-c['mean'], 2)} points below"))
-                dsr = x["arms"][L]["metrics"].get("dsr")
-                if dsr:
-                    out.append(target_row("assist mode: DSR", cell, L, f"{fmt(dsr['mean'], 1)} %",
-                                          f"≥ {t['assist_dsr_pct']:g} %", dsr["mean"] >= t["assist_dsr_pct"],
-                                          f"{fmt(t['assist_dsr_pct'] - dsr['mean'], 1)} points below"))
+                out += dsr_targets("assist mode", x, L, t["assist_dsr_pct"], t["native_arm"], censored=False)
     for x in fed:
         e = next((e for e in x["entries"] if e["arm"] == t["federation_control"]), None)
         if e is None or x["reference"] != t["federation_reference"] or e["ratio"]["n"] < 2:
@@ -1426,7 +1454,10 @@ def targets_section(targets):
              "on each cell where its arms ran, from the numbers above: against the cell's best control "
              "unless named; intervals are the span of the bootstrap and paired-t 95 % intervals. A "
              "comparison made on one training of each side is read with the spread between trainings "
-             "(the section above) in mind."]
+             "(the section above) in mind. A DSR target reads the exits decided by the end of a run "
+             "(served or missed) against its bar; advisory mode's also reads the rate that counts the "
+             "exit-bound CAVs still on the road at the end as not served, against `sumo_native`'s on the "
+             "same seeds, since the end of a run leaves such CAVs whoever drives."]
     for arm, variant in stand_ins:
         lines[-1] += (f" `{arm}` is read as it ships: from the rows of the variant `{variant}` (above), "
                       f"not the trial's own `{arm}` rows; a cell where the variant did not run has no "
