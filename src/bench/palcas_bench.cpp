@@ -16,6 +16,11 @@
 //     256 x batch), one thread; grad_step_floor_ms = grad_step_gflop / that rate, the time the
 //     update's own arithmetic needs on this core at best (what a faster kernel cannot beat
 //     without doing less arithmetic or lower precision);
+//   gemm_bf16_gflops_1thread: the same product in bfloat16 with float sums (AVX-512 BF16,
+//     learning/nn/bf16_gemm.h; the input converted in each call, the weights packed once);
+//     grad_step_bf16_bound_ms = the step with its arithmetic at that rate and the rest of it
+//     (the step minus grad_step_floor_ms) unchanged: what a bfloat16 step could reach at best
+//     (null where the build has no AVX-512 BF16);
 //   load_average_start/end: /proc/loadavg 1-minute load when the run started / ended.
 // Google Benchmark runs the repetitions, times the fixed iteration counts and takes the
 // medians; percentiles over single calls are no figure of its own, so those benchmarks time
@@ -38,6 +43,7 @@
 #include <unistd.h>
 
 #include "palcas_core/learning/fedavg.h"
+#include "palcas_core/learning/nn/bf16_gemm.h"
 #include "palcas_core/learning/nn/linear.h"
 #include "palcas_core/learning/pdqn_agent.h"
 
@@ -186,6 +192,21 @@ void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
     for (auto _ : state) benchmark::DoNotOptimize(layer.forward(batch, false).data());
     state.counters["gflop"] = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
   })->Iterations(200);
+  if (nn::bf16GemmAvailable()) {
+    benchmark::RegisterBenchmark("gemm_largest_layer_bf16", [&agent](benchmark::State& state) {
+      Rng rng(8);
+      const int widest = *std::max_element(agent.config().hidden_sizes.begin(), agent.config().hidden_sizes.end());
+      const nn::Bf16Weights weights = nn::packBf16(randomStates(widest, 256, rng));
+      const nn::Matrix batch = randomStates(256, agent.config().batch_size, rng);
+      nn::Matrix out;
+      std::vector<uint16_t> scratch;
+      for (auto _ : state) {
+        nn::bf16Gemm(weights, batch, out, scratch);
+        benchmark::DoNotOptimize(out.data());
+      }
+      state.counters["gflop"] = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
+    })->Iterations(200);
+  }
   for (int cavs : CAV_COUNTS) {
     benchmark::RegisterBenchmark(
         ("act/cavs:" + std::to_string(cavs)).c_str(),
@@ -337,6 +358,11 @@ int main(int argc, char** argv) {
   const double gemm_gflops = collector.value("gemm_largest_layer", "gflop") / (collector.time("gemm_largest_layer").cpu_ms * 1e-3);
   const double step_gflops = step_gflop / (grad_1.cpu_ms * 1e-3);
   const double floor_ms = step_gflop / gemm_gflops * 1e3;
+  const bool bf16 = nn::bf16GemmAvailable();
+  const double bf16_gflops =
+      bf16 ? collector.value("gemm_largest_layer_bf16", "gflop") / (collector.time("gemm_largest_layer_bf16").cpu_ms * 1e-3)
+           : 0.0;
+  const double bf16_bound_ms = bf16 ? grad_1.cpu_ms - floor_ms + step_gflop / bf16_gflops * 1e3 : 0.0;
   for (int count : MODEL_COUNTS) {
     const Timing t = collector.time("fedavg/models:" + std::to_string(count));
     fed_cpu[count] = t.cpu_ms;
@@ -363,6 +389,13 @@ int main(int argc, char** argv) {
   std::printf("gradient step arithmetic: %.3f GFLOP at %.1f GFLOP/s; Eigen's product of the widest layer"
               " runs %.1f GFLOP/s, so the same arithmetic needs >= %.2f ms here (%.0f %% of the step)\n",
               step_gflop, step_gflops, gemm_gflops, floor_ms, 100.0 * floor_ms / grad_1.cpu_ms);
+  if (bf16) {
+    std::printf("bfloat16 (AVX-512 BF16): the widest layer's product runs %.1f GFLOP/s (%.2f x Eigen's float);"
+                " a step with its arithmetic at that rate and the rest unchanged: >= %.2f ms (%.2f x today's)\n",
+                bf16_gflops, bf16_gflops / gemm_gflops, bf16_bound_ms, bf16_bound_ms / grad_1.cpu_ms);
+  } else {
+    std::printf("bfloat16: not measured (this build has no AVX-512 BF16)\n");
+  }
 
   const std::filesystem::path path(out_path);
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
@@ -392,7 +425,9 @@ int main(int argc, char** argv) {
       << "  \"grad_step_gflop\": " << step_gflop << ",\n"
       << "  \"grad_step_gflops_1thread\": " << step_gflops << ",\n"
       << "  \"gemm_gflops_1thread\": " << gemm_gflops << ",\n"
-      << "  \"grad_step_floor_ms\": " << floor_ms << "\n}\n";
+      << "  \"grad_step_floor_ms\": " << floor_ms << ",\n"
+      << "  \"gemm_bf16_gflops_1thread\": " << (bf16 ? std::to_string(bf16_gflops) : "null") << ",\n"
+      << "  \"grad_step_bf16_bound_ms\": " << (bf16 ? std::to_string(bf16_bound_ms) : "null") << "\n}\n";
   if (!out) {
     std::fprintf(stderr, "palcas_bench: cannot write %s\n", out_path.c_str());
     return 1;

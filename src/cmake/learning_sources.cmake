@@ -2,6 +2,7 @@
 # PDQN agent, FedAvg
 list(APPEND PALCAS_CORE_SOURCES
   lib/learning/nn/linear.cpp
+  lib/learning/nn/bf16_gemm.cpp
   lib/learning/nn/activation.cpp
   lib/learning/nn/batch_norm.cpp
   lib/learning/nn/dropout.cpp

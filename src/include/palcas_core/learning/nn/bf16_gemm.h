@@ -1,0 +1,39 @@
+#pragma once
+// A bfloat16 matrix product with float accumulation (AVX-512 BF16), for measuring what lower
+// precision could buy the gradient step (issue "Training at the simulator's speed"): the
+// benchmark times it against Eigen's float product on the network's largest layer. Nothing
+// in the learning uses it: a bf16 update changes the updates, which must first be shown not
+// to change the learning (docs/journal/experiments.md, "What bfloat16 could buy the step").
+
+#include <cstdint>
+#include <vector>
+
+#include "palcas_core/learning/nn/types.h"
+
+namespace palcas::nn {
+
+/// true when this build runs bf16Gemm: compiled for a CPU with AVX-512 BF16 (the core
+/// follows -march, src/CMakeLists.txt). Otherwise bf16Gemm and packBf16 throw.
+bool bf16GemmAvailable();
+
+/// The float nearest to `x` in bfloat16 (round to nearest, ties to even; NaN stays NaN).
+float roundToBf16(float x);
+
+/// Weights W (rows x cols) in bfloat16, packed for bf16Gemm: 16-row panels, each column pair
+/// (k, k+1) interleaved so one 32-bit word holds W(i, k) and W(i, k + 1).
+struct Bf16Weights {
+  Index rows = 0, cols = 0;
+  std::vector<uint32_t> pairs;
+};
+
+/// Packs W. Throws std::invalid_argument naming the shape unless rows is a multiple of 32 and
+/// cols of 2 and W is finite; std::logic_error when !bf16GemmAvailable().
+Bf16Weights packBf16(const Matrix& w);
+
+/// out = W x with W's and x's entries rounded to bfloat16 and the sums in float (out is
+/// resized to W.rows x x.cols). x: W.cols x batch, batch a multiple of 8. `x_scratch` holds
+/// x in bfloat16 between calls (no allocation once sized). Throws std::invalid_argument naming
+/// the shapes when they do not fit, std::logic_error when !bf16GemmAvailable().
+void bf16Gemm(const Bf16Weights& w, const Matrix& x, Matrix& out, std::vector<uint16_t>& x_scratch);
+
+}  // namespace palcas::nn

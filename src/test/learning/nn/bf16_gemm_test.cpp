@@ -1,0 +1,94 @@
+#include "palcas_core/learning/nn/bf16_gemm.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <tuple>
+#include <stdexcept>
+
+#include "common/throws_naming.h"
+
+using namespace palcas::nn;
+
+namespace {
+
+Matrix randomMatrix(Index rows, Index cols, uint32_t seed) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  Matrix m(rows, cols);
+  for (Index i = 0; i < m.size(); ++i) m.data()[i] = normal(gen);
+  return m;
+}
+
+Matrix roundedToBf16(const Matrix& m) { return m.unaryExpr([](float v) { return roundToBf16(v); }); }
+
+}  // namespace
+
+TEST(Bf16, RoundsToTheNearestBfloat16TiesToEven) {
+  EXPECT_EQ(roundToBf16(1.0f), 1.0f);
+  // bfloat16 keeps 8 significant bits: between 1 and 2 its step is 2^-7.
+  EXPECT_EQ(roundToBf16(1.0f + 0.4f / 128), 1.0f);
+  EXPECT_EQ(roundToBf16(1.0f + 0.6f / 128), 1.0f + 1.0f / 128);
+  EXPECT_EQ(roundToBf16(1.0f + 0.5f / 128), 1.0f);                      // tie: to the even 1.0
+  EXPECT_EQ(roundToBf16(1.0f + 1.5f / 128), 1.0f + 2.0f / 128);         // tie: to the even 1 + 2/128
+  EXPECT_EQ(roundToBf16(-3.0f), -3.0f);
+  EXPECT_TRUE(std::isinf(roundToBf16(std::numeric_limits<float>::infinity())));
+  EXPECT_TRUE(std::isnan(roundToBf16(std::numeric_limits<float>::quiet_NaN())));
+}
+
+TEST(Bf16Gemm, EqualsTheFloatProductOfTheRoundedInputs) {
+  if (!bf16GemmAvailable()) GTEST_SKIP() << "built for a CPU without AVX-512 BF16";
+  // The network's largest layer (512 x 256) times a batch of 24, and a small odd-sized one.
+  for (const auto& [rows, depth, batch] : {std::tuple<Index, Index, Index>{512, 256, 24}, {32, 6, 8}}) {
+    const Matrix w = randomMatrix(rows, depth, 1), x = randomMatrix(depth, batch, 2);
+    Matrix out;
+    std::vector<uint16_t> scratch;
+    bf16Gemm(packBf16(w), x, out, scratch);
+    ASSERT_EQ(out.rows(), rows);
+    ASSERT_EQ(out.cols(), batch);
+    // What it must compute: the product of the rounded inputs (here in double; left are only
+    // float sums in another order); and what that costs against the product of the inputs
+    // as given: bfloat16's ~3 significant digits. (Loops, not Eigen products: GCC 12 warns
+    // inside Eigen's AVX-512 kernels, so the library keeps them out of the tests.)
+    const Matrix wr = roundedToBf16(w), xr = roundedToBf16(x);
+    double worst_rounded = 0.0, worst_plain = 0.0;
+    for (Index j = 0; j < batch; ++j) {
+      for (Index i = 0; i < rows; ++i) {
+        double rounded = 0.0, plain = 0.0;
+        for (Index k = 0; k < depth; ++k) {
+          rounded += static_cast<double>(wr(i, k)) * xr(k, j);
+          plain += static_cast<double>(w(i, k)) * x(k, j);
+        }
+        worst_rounded = std::max(worst_rounded, std::abs(out(i, j) - rounded));
+        worst_plain = std::max(worst_plain, std::abs(out(i, j) - plain));
+      }
+    }
+    const double scale = std::sqrt(static_cast<double>(depth));  // the sums' size
+    EXPECT_LT(worst_rounded, 1e-5 * scale) << rows << " x " << depth;
+    EXPECT_GT(worst_plain, 1e-4 * scale) << "bfloat16 inputs: not the float product";
+    EXPECT_LT(worst_plain, 0.02 * scale);
+  }
+}
+
+TEST(Bf16Gemm, RefusesShapesItCannotRunNamingThem) {
+  if (!bf16GemmAvailable()) {
+    palcas_test::expectThrowNaming<std::logic_error>([] { packBf16(Matrix::Zero(32, 2)); }, "AVX-512 BF16");
+    return;
+  }
+  palcas_test::expectThrowNaming<std::invalid_argument>([] { packBf16(Matrix::Zero(30, 2)); }, "30 x 2");
+  palcas_test::expectThrowNaming<std::invalid_argument>([] { packBf16(Matrix::Zero(32, 3)); }, "32 x 3");
+  Matrix nan = Matrix::Zero(32, 2);
+  nan(3, 1) = std::numeric_limits<float>::quiet_NaN();
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { packBf16(nan); }, "not finite");
+  const Bf16Weights w = packBf16(Matrix::Ones(32, 4));
+  Matrix out = Matrix::Constant(2, 2, 7.0f);
+  std::vector<uint16_t> scratch;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { bf16Gemm(w, Matrix::Ones(6, 8), out, scratch); },
+                                                        "input 6 x 8");
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { bf16Gemm(w, Matrix::Ones(4, 5), out, scratch); },
+                                                        "input 4 x 5");
+  EXPECT_EQ(out, Matrix::Constant(2, 2, 7.0f)) << "a refused product leaves its output alone";
+}
