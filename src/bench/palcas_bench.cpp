@@ -181,21 +181,21 @@ void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
         ->Iterations(20);  // a repetition's figure: the mean over 20 updates
   }
   // Eigen's float product at the network's largest layer (512 x 256) times a batch, one thread.
-  benchmark::RegisterBenchmark("gemm_largest_layer", [&agent](benchmark::State& state) {
+  const int widest = *std::max_element(agent.config().hidden_sizes.begin(), agent.config().hidden_sizes.end());
+  const double largest_layer_gflop = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
+  benchmark::RegisterBenchmark("gemm_largest_layer", [&agent, widest, largest_layer_gflop](benchmark::State& state) {
     Rng rng(8);
-    const int widest = *std::max_element(agent.config().hidden_sizes.begin(), agent.config().hidden_sizes.end());
     // Through the library's own Linear layer (its product is Eigen's GEMM; the bias add is
     // 1/256 of the work), which also keeps Eigen's products out of this file.
     nn::Linear layer(256, widest, rng);
     const nn::Matrix batch = randomStates(256, agent.config().batch_size, rng);
     Eigen::setNbThreads(1);
     for (auto _ : state) benchmark::DoNotOptimize(layer.forward(batch, false).data());
-    state.counters["gflop"] = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
+    state.counters["gflop"] = largest_layer_gflop;
   })->Iterations(200);
   if (nn::bf16GemmAvailable()) {
-    benchmark::RegisterBenchmark("gemm_largest_layer_bf16", [&agent](benchmark::State& state) {
+    benchmark::RegisterBenchmark("gemm_largest_layer_bf16", [&agent, widest, largest_layer_gflop](benchmark::State& state) {
       Rng rng(8);
-      const int widest = *std::max_element(agent.config().hidden_sizes.begin(), agent.config().hidden_sizes.end());
       const nn::Bf16Weights weights = nn::packBf16(randomStates(widest, 256, rng));
       const nn::Matrix batch = randomStates(256, agent.config().batch_size, rng);
       nn::Matrix out;
@@ -204,7 +204,7 @@ void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
         nn::bf16Gemm(weights, batch, out, scratch);
         benchmark::DoNotOptimize(out.data());
       }
-      state.counters["gflop"] = 2.0 * widest * 256.0 * agent.config().batch_size * 1e-9;
+      state.counters["gflop"] = largest_layer_gflop;
     })->Iterations(200);
   }
   for (int cavs : CAV_COUNTS) {

@@ -5,23 +5,16 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <random>
 #include <tuple>
 #include <stdexcept>
 
 #include "common/throws_naming.h"
+#include "nn_test_util.h"
 
 using namespace palcas::nn;
+using palcas::nn::test::randomMatrix;
 
 namespace {
-
-Matrix randomMatrix(Index rows, Index cols, uint32_t seed) {
-  std::mt19937 gen(seed);
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  Matrix m(rows, cols);
-  for (Index i = 0; i < m.size(); ++i) m.data()[i] = normal(gen);
-  return m;
-}
 
 Matrix roundedToBf16(const Matrix& m) { return m.unaryExpr([](float v) { return roundToBf16(v); }); }
 
@@ -43,7 +36,8 @@ TEST(Bf16Gemm, EqualsTheFloatProductOfTheRoundedInputs) {
   if (!bf16GemmAvailable()) GTEST_SKIP() << "built for a CPU without AVX-512 BF16";
   // The network's largest layer (512 x 256) times a batch of 24, and a small odd-sized one.
   for (const auto& [rows, depth, batch] : {std::tuple<Index, Index, Index>{512, 256, 24}, {32, 6, 8}}) {
-    const Matrix w = randomMatrix(rows, depth, 1), x = randomMatrix(depth, batch, 2);
+    palcas::Rng rng(1);
+    const Matrix w = randomMatrix(rows, depth, rng), x = randomMatrix(depth, batch, rng);
     Matrix out;
     std::vector<uint16_t> scratch;
     bf16Gemm(packBf16(w), x, out, scratch);
