@@ -284,6 +284,8 @@ json guardJson(const BridgeOptions& o, const sim::GuardCounters& g) {
           {"accelerate_cav_s", dt * g.accelerate_steps},
           {"accelerate_floored_cav_s", dt * g.accelerate_floored_steps},
           {"accelerate_released_cav_s", dt * g.accelerate_released_steps},
+          {"accelerate_advice", o.session.guard.accelerate_advice},
+          {"accelerate_own_driving_cav_s", dt * g.accelerate_own_driving_steps},
           {"accelerate_guarded_pct", share(g.accelerate_floored_steps + g.accelerate_released_steps, g.accelerate_steps)},
           {"lane_change_cav_s", dt * g.lane_change_steps},
           {"lane_change_released_cav_s", dt * g.lane_change_released_steps},

@@ -35,6 +35,7 @@ void forEachGuardKey(GuardOptionsT& g, F&& f) {
   f("guard_busy_change_max_accel_mps2", g.busy_change_max_accel_mps2, 0.0, 20.0);
   f("guard_busy_change_hold_s", g.busy_change_hold_s, 0.0, 600.0);
   f("guard_insertion_edge", g.insertion_edge);
+  f("guard_accelerate_advice", g.accelerate_advice);
 }
 
 /// The advice guard's options from the keys guard_* (forEachGuardKey).

@@ -86,6 +86,11 @@ HeldAcceleration AdviceGuard::holdAcceleration(const GuardCav& cav, double accel
   // bounds how far: never below the floor.
   ++counters_.accelerate_steps;
   HeldAcceleration out;
+  if (options_.enabled && !options_.accelerate_advice) {
+    ++counters_.accelerate_own_driving_steps;
+    out.kind = HeldAcceleration::Kind::kReleased;
+    return out;
+  }
   out.target_mps = std::max(0.0, cav.speed_mps + accel_mps2 * step_s);
   const double floor = floorMps(cav);
   if (out.target_mps >= floor) return out;

@@ -218,6 +218,29 @@ TEST(GuardFloor, BelowTheFloorACavDrivesItself) {
   EXPECT_EQ(g.counters().accelerate_released_steps, 1u);
 }
 
+TEST(GuardFloor, WithAccelerationAdviceOffEveryAccelerateIsTheCavsOwnDriving) {
+  GuardOptions o;
+  o.accelerate_advice = false;
+  AdviceGuard g(o);
+  for (double accel : {2.0, 0.0, -4.0}) {  // above, at and below the floor's reach
+    const HeldAcceleration h = g.holdAcceleration(cav(25.0), accel, kStepS);
+    EXPECT_EQ(h.kind, HeldAcceleration::Kind::kReleased) << accel;
+  }
+  EXPECT_EQ(g.counters().accelerate_steps, 3u);
+  EXPECT_EQ(g.counters().accelerate_own_driving_steps, 3u);
+  EXPECT_EQ(g.counters().accelerate_floored_steps, 0u);
+  EXPECT_EQ(g.counters().accelerate_released_steps, 0u);
+  // Lane changes are judged as before: the option touches accelerations only.
+  AdviceCase change;
+  change.lane_change = true;
+  change.time_s = 100.0;
+  EXPECT_EQ(g.judgeAdvice(change, GuardMemory{}), AdviceVerdict::kCarryOut);
+  // With the guard off no rule acts, this one included (the paper).
+  o.enabled = false;
+  AdviceGuard off(o);
+  EXPECT_EQ(off.holdAcceleration(cav(25.0), 2.0, kStepS).kind, HeldAcceleration::Kind::kCommand);
+}
+
 TEST(GuardFloor, WithoutAFloorTheCommandReachesTheCarNeverBelowStandstill) {
   GuardOptions o;
   o.enabled = false;

@@ -28,6 +28,9 @@ struct GuardOptions {
   double busy_change_max_accel_mps2 = 1.47;
   double busy_change_hold_s = 4.0;
   bool insertion_edge = true;
+  /// false: an ACCELERATE advisory is carried out as the CAV's own car following (as under
+  /// KEEP), so the learned advice reaches the car as lane changes only. true: the paper.
+  bool accelerate_advice = true;
 };
 
 /// How often the advice guard acted, in CAV steps.
@@ -35,6 +38,7 @@ struct GuardCounters {
   std::uint64_t accelerate_steps = 0;         ///< CAV steps under an ACCELERATE command
   std::uint64_t accelerate_floored_steps = 0; ///< ... held at the floor instead of the command
   std::uint64_t accelerate_released_steps = 0;///< ... driven by its own model (below the floor)
+  std::uint64_t accelerate_own_driving_steps = 0;///< ... driven by its own model (accelerate_advice off)
   std::uint64_t lane_change_steps = 0;        ///< CAV steps with an advised change under way
   std::uint64_t lane_change_released_steps = 0;///< ... with the acceleration bound lifted
   std::uint64_t lane_changes_advised = 0;       ///< advised changes received
@@ -144,7 +148,7 @@ class AdviceGuard {
   /// An advised change was made in its target lane at `time_s` (for the cooldown).
   static void laneChangeMade(GuardMemory& memory, double time_s) { memory.last_lane_change_s = time_s; }
   /// One step of a held ACCELERATE (counted): never below the floor, or, below it already,
-  /// its own driving.
+  /// its own driving; always its own driving with accelerate_advice off.
   HeldAcceleration holdAcceleration(const GuardCav& cav, double accel_mps2, double step_s);
   /// One step of an advised change under way (counted): true when its acceleration bound is
   /// lifted (the CAV is below the floor: queued or slowed, it gets going at its own rate).
