@@ -364,6 +364,10 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   }
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
+    // The rule advises RIGHT only for an exit-bound CAV's exit, which every mask allows.
+    if (options_.exit_rule_override &&
+        ruleDecision(*obs.member_vehicles[i], options_.num_lanes, options_.rules).action == Action::kLaneRight)
+      decisions[i] = Decision{Action::kLaneRight, 0.0f};
     allowed[i] = allowedFor(*obs.member_vehicles[i], time_s);
     if ((allowed[i] & actionBit(decisions[i].action)) == 0) decisions[i].action = Action::kKeep;
   }

@@ -216,3 +216,31 @@ TEST(RuleAdvisor, AResidualOnKeepAdvisesKeepUntilDepartingPaysByTheMargin) {
   residual.residual_margin = 0.0;  // the network's wherever its Q beats KEEP's
   EXPECT_EQ(actions(residual), alone);
 }
+
+TEST(RuleAdvisor, TheExitRuleOverrideSendsTheRulesExitBoundCavsRightWhateverTheNetworkSaid) {
+  RsuControllerOptions network = ruleController();
+  network.advice_source = AdviceSource::kNetwork;
+  RsuControllerOptions overridden = network;
+  overridden.exit_rule_override = true;
+  // exit_near (lane 4, 500 m to go, below the rule's 100 + 3 x 300 m) is the rule's one RIGHT.
+  const std::vector<Action> rule = residualActions(ruleController());
+  ASSERT_EQ(rule[1], Action::kLaneRight);
+  std::vector<Action> expected = residualActions(network);
+  expected[1] = Action::kLaneRight;
+  EXPECT_EQ(residualActions(overridden), expected) << "only exit_near's advice changes";
+
+  // Decisions from outside (the batched learner's adviseWith) get the same override.
+  RoadSnapshot road;
+  road.num_lanes = LANES;
+  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  const std::vector<palcas::Decision> keep(3, palcas::Decision{Action::kKeep, 0.0f});
+  const auto actions = [&](const RsuControllerOptions& o) {
+    RsuController rsu(o);
+    std::vector<Action> out;
+    for (const auto& a : rsu.adviseWith(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{}, keep).advisories)
+      out.push_back(a.decision.action);
+    return out;
+  };
+  EXPECT_EQ(actions(network), (std::vector<Action>{Action::kKeep, Action::kKeep, Action::kKeep}));
+  EXPECT_EQ(actions(overridden), (std::vector<Action>{Action::kKeep, Action::kLaneRight, Action::kKeep}));
+}

@@ -67,6 +67,11 @@ struct RsuControllerOptions {
   /// lane: such advice becomes KEEP, and in train mode the action is left out of its state's
   /// valid actions. The lane is seen at this RSU's decisions. >= 0 [s]; 0 (paper) = off.
   double lane_change_dwell_s = 0.0;
+  /// true: an exit-bound CAV that the rule (`rules`, rule 2 of rule_advisor.h) would advise
+  /// right towards its exit is advised right, whatever the network or adviseWith() chose: the
+  /// `rules` control arm's exit service under the learned advice, so a CAV the network leaves
+  /// in its lane too long still reaches its off-ramp. Not learned; false (paper) = off.
+  bool exit_rule_override = false;
   /// Subtracted from the reward of a transition whose advice was a lane change that does not
   /// serve the CAV's route (anything but an exit-bound CAV's change right and the merge off
   /// the acceleration lane): the speed-gain changes a policy makes too many of cost something,
