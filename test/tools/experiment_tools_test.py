@@ -900,6 +900,46 @@ class TrainingPaceTest(unittest.TestCase):
         self.assertEqual(log.read_text().strip(), "ran")
 
 
+def merged_yaml(*paths):
+    """The keys of the YAML files, later files over earlier ones, nested mappings merged."""
+    import yaml
+
+    def merge(into, more):
+        for k, v in more.items():
+            if isinstance(v, dict) and isinstance(into.get(k), dict):
+                merge(into[k], v)
+            else:
+                into[k] = v
+        return into
+
+    out = {}
+    for p in paths:
+        merge(out, yaml.safe_load((ROOT / p).read_text()) or {})
+    return out
+
+
+class OverrideUnionsTest(unittest.TestCase):
+    """--bridge-params and --rsu-params take one file each, so a setting made of several has a
+    file of its own: each must stay the union of the files it says it is made of."""
+    UNIONS = {
+        "config/training/lane_change_advice_bridge.yaml": ["config/training/gentle_lane_changes.yaml",
+                                                           "config/training/lane_changes_only.yaml"],
+        "config/training/lane_change_advice_rsu.yaml": ["config/training/personal_heads.yaml",
+                                                        "docs/experiment/lane_change_dwell_dev/dwell_10s.yaml"],
+        "docs/experiment/exit_rule_dev/combination_exit_rule.yaml": [
+            "docs/experiment/lane_change_dwell_dev/dwell_10s.yaml", "docs/experiment/exit_rule_dev/exit_rule.yaml"],
+    }
+
+    def test_each_union_file_equals_its_parts(self):
+        for union, parts in self.UNIONS.items():
+            with self.subTest(union=union):
+                self.assertEqual(merged_yaml(union), merged_yaml(*parts))
+
+    def test_the_check_can_fail(self):
+        self.assertNotEqual(merged_yaml("config/training/lane_change_advice_rsu.yaml"),
+                            merged_yaml("config/training/personal_heads.yaml"))
+
+
 def main():
     run_as_junit(sys.modules[__name__], "experiment_tools")
 
