@@ -60,6 +60,9 @@ void RsuControllerOptions::validate() const {
           no_left_for_exit_within_m, "must be finite and >= 0 (0 = off)");
   require(std::isfinite(lane_change_dwell_s) && lane_change_dwell_s >= 0.0, "lane_change_dwell_s",
           lane_change_dwell_s, "must be finite and >= 0 (0 = off)");
+  require(std::isfinite(exit_rule_below_density_veh_per_km) && exit_rule_below_density_veh_per_km >= 0.0,
+          "exit_rule_below_density_veh_per_km", exit_rule_below_density_veh_per_km,
+          "must be finite and >= 0 (0 = at any density)");
   require(std::isfinite(lane_change_cost) && lane_change_cost >= 0.0, "lane_change_cost", lane_change_cost,
           "must be finite and >= 0 (it is subtracted; 0 = off)");
   nested("rules", [&] { rules.validate(); });
@@ -362,10 +365,14 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   } else if (!obs.member_ids.empty()) {
     agent_.act(obs.member_states, options_.train, decisions);
   }
+  const double lane_density_veh_per_km = obs.cluster.density_veh_per_km / options_.num_lanes;
+  const bool exit_rule_acts =
+      options_.exit_rule_override && (options_.exit_rule_below_density_veh_per_km <= 0.0 ||
+                                      lane_density_veh_per_km < options_.exit_rule_below_density_veh_per_km);
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
     // The rule advises RIGHT only for an exit-bound CAV's exit, which every mask allows.
-    if (options_.exit_rule_override &&
+    if (exit_rule_acts &&
         ruleDecision(*obs.member_vehicles[i], options_.num_lanes, options_.rules).action == Action::kLaneRight)
       decisions[i] = Decision{Action::kLaneRight, 0.0f};
     allowed[i] = allowedFor(*obs.member_vehicles[i], time_s);

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -243,4 +244,32 @@ TEST(RuleAdvisor, TheExitRuleOverrideSendsTheRulesExitBoundCavsRightWhateverTheN
   };
   EXPECT_EQ(actions(network), (std::vector<Action>{Action::kKeep, Action::kKeep, Action::kKeep}));
   EXPECT_EQ(actions(overridden), (std::vector<Action>{Action::kKeep, Action::kLaneRight, Action::kKeep}));
+}
+
+TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsDensity) {
+  RsuControllerOptions overridden = ruleController();
+  overridden.advice_source = AdviceSource::kNetwork;
+  overridden.exit_rule_override = true;
+  RoadSnapshot road;
+  road.num_lanes = LANES;
+  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  // Three vehicles in an 800 m zone of five lanes: 3 / 0.8 / 5 = 0.75 veh/km per lane.
+  const std::vector<palcas::Decision> keep(3, palcas::Decision{Action::kKeep, 0.0f});
+  const auto nearAction = [&](double below) {
+    RsuControllerOptions o = overridden;
+    o.exit_rule_below_density_veh_per_km = below;
+    RsuController rsu(o);
+    return rsu.adviseWith(road, 10, 1.0, GlobalDensities{}, VehicleOutcomes{}, keep).advisories[1].decision.action;
+  };
+  EXPECT_EQ(nearAction(0.0), Action::kLaneRight) << "0: at any density";
+  EXPECT_EQ(nearAction(0.76), Action::kLaneRight) << "the zone is below the limit";
+  EXPECT_EQ(nearAction(0.75), Action::kKeep) << "at the limit the network's advice stands";
+  EXPECT_EQ(nearAction(0.5), Action::kKeep);
+
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    RsuControllerOptions o = overridden;
+    o.exit_rule_below_density_veh_per_km = bad;
+    palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController rsu(o); },
+                                                         "exit_rule_below_density_veh_per_km");
+  }
 }

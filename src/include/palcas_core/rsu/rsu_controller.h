@@ -72,6 +72,10 @@ struct RsuControllerOptions {
   /// `rules` control arm's exit service under the learned advice, so a CAV the network leaves
   /// in its lane too long still reaches its off-ramp. Not learned; false (paper) = off.
   bool exit_rule_override = false;
+  /// With exit_rule_override: the override acts only while this zone's mainline density,
+  /// averaged over its lanes, is below this [veh/km per lane], so it serves exits at light
+  /// traffic and leaves a busy road's right lanes alone. >= 0; 0 = at any density.
+  double exit_rule_below_density_veh_per_km = 0.0;
   /// Subtracted from the reward of a transition whose advice was a lane change that does not
   /// serve the CAV's route (anything but an exit-bound CAV's change right and the merge off
   /// the acceleration lane): the speed-gain changes a policy makes too many of cost something,
