@@ -21,6 +21,9 @@
 //     grad_step_bf16_bound_ms = the step with its arithmetic at that rate and the rest of it
 //     (the step minus grad_step_floor_ms) unchanged: what a bfloat16 step could reach at best
 //     (null where the build has no AVX-512 BF16);
+//   grad_step_bf16_ms_1thread: the gradient step with learning/bf16_products on (its products
+//     in bfloat16 where the layer shapes fit), same network, batch and prefill, one thread
+//     (null without AVX-512 BF16); grad_step_bf16_ratio = that / grad_step_ms_1thread;
 //   load_average_start/end: /proc/loadavg 1-minute load when the run started / ended.
 // Google Benchmark runs the repetitions, times the fixed iteration counts and takes the
 // medians; percentiles over single calls are no figure of its own, so those benchmarks time
@@ -37,6 +40,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -168,7 +172,14 @@ double gradStepGflop(const PdqnConfig& c) {
 
 // The benchmarks, in the order they run (registration order); all share one agent, as the
 // figures always did (the decision timings run on an agent that has been updated).
-void registerBenchmarks(PdqnAgent& agent, ModelBlob& base, int reps) {
+void registerBenchmarks(PdqnAgent& agent, PdqnAgent* agent_bf16, ModelBlob& base, int reps) {
+  if (agent_bf16 != nullptr) {
+    benchmark::RegisterBenchmark("grad_step_bf16/threads:1", [agent_bf16](benchmark::State& state) {
+      Eigen::setNbThreads(1);
+      for (int i = 0; i < 3; ++i) agent_bf16->update();
+      for (auto _ : state) agent_bf16->update();
+    })->Iterations(20);
+  }
   for (int threads : {1, 2}) {
     benchmark::RegisterBenchmark(
         ("grad_step/threads:" + std::to_string(threads)).c_str(),
@@ -327,9 +338,16 @@ int main(int argc, char** argv) {
   PdqnConfig config;  // the paper's network and hyper-parameters
   PdqnAgent agent(config);
   prefill(agent, 10000);
+  std::unique_ptr<PdqnAgent> agent_bf16;
+  if (nn::bf16GemmAvailable()) {
+    PdqnConfig low = config;
+    low.bf16_products = true;
+    agent_bf16 = std::make_unique<PdqnAgent>(low);
+    prefill(*agent_bf16, 10000);
+  }
   Eigen::setNbThreads(1);
   ModelBlob base_model;  // exported by the first FedAvg benchmark
-  registerBenchmarks(agent, base_model, reps);
+  registerBenchmarks(agent, agent_bf16.get(), base_model, reps);
   // Colours only on a terminal: a log of ./palcas bench gets no escape codes.
   Collector collector(isatty(fileno(stdout)) ? benchmark::ConsoleReporter::OO_ColorTabular
                                              : benchmark::ConsoleReporter::OO_Tabular);
@@ -363,6 +381,7 @@ int main(int argc, char** argv) {
       bf16 ? collector.value("gemm_largest_layer_bf16", "gflop") / (collector.time("gemm_largest_layer_bf16").cpu_ms * 1e-3)
            : 0.0;
   const double bf16_bound_ms = bf16 ? grad_1.cpu_ms - floor_ms + step_gflop / bf16_gflops * 1e3 : 0.0;
+  const Timing grad_bf16 = bf16 ? collector.time("grad_step_bf16/threads:1") : Timing{};
   for (int count : MODEL_COUNTS) {
     const Timing t = collector.time("fedavg/models:" + std::to_string(count));
     fed_cpu[count] = t.cpu_ms;
@@ -378,6 +397,7 @@ int main(int argc, char** argv) {
   std::printf("%-52s %10s %10s\n", "measure", "cpu ms", "wall ms");
   printRow("P-DQN gradient step, batch 256, 1 thread", grad_1.cpu_ms, grad_1.wall_ms);
   printRow("P-DQN gradient step, batch 256, 2 threads", -1, grad_2.wall_ms);
+  if (bf16) printRow("P-DQN gradient step, bf16 products, 1 thread", grad_bf16.cpu_ms, grad_bf16.wall_ms);
   for (int cavs : CAV_COUNTS) {
     const std::string name = "act() " + std::to_string(cavs) + " CAVs, eval, 1 thread";
     printRow(name + ", p50", p50[cavs], wall_p50[cavs]);
@@ -393,6 +413,8 @@ int main(int argc, char** argv) {
     std::printf("bfloat16 (AVX-512 BF16): the widest layer's product runs %.1f GFLOP/s (%.2f x Eigen's float);"
                 " a step with its arithmetic at that rate and the rest unchanged: >= %.2f ms (%.2f x today's)\n",
                 bf16_gflops, bf16_gflops / gemm_gflops, bf16_bound_ms, bf16_bound_ms / grad_1.cpu_ms);
+    std::printf("the step with learning/bf16_products: %.2f ms, %.2f x the float step\n", grad_bf16.cpu_ms,
+                grad_bf16.cpu_ms / grad_1.cpu_ms);
   } else {
     std::printf("bfloat16: not measured (this build has no AVX-512 BF16)\n");
   }
@@ -427,7 +449,10 @@ int main(int argc, char** argv) {
       << "  \"gemm_gflops_1thread\": " << gemm_gflops << ",\n"
       << "  \"grad_step_floor_ms\": " << floor_ms << ",\n"
       << "  \"gemm_bf16_gflops_1thread\": " << (bf16 ? std::to_string(bf16_gflops) : "null") << ",\n"
-      << "  \"grad_step_bf16_bound_ms\": " << (bf16 ? std::to_string(bf16_bound_ms) : "null") << "\n}\n";
+      << "  \"grad_step_bf16_bound_ms\": " << (bf16 ? std::to_string(bf16_bound_ms) : "null") << ",\n"
+      << "  \"grad_step_bf16_ms_1thread\": " << (bf16 ? std::to_string(grad_bf16.cpu_ms) : "null") << ",\n"
+      << "  \"grad_step_bf16_ratio\": " << (bf16 ? std::to_string(grad_bf16.cpu_ms / grad_1.cpu_ms) : "null")
+      << "\n}\n";
   if (!out) {
     std::fprintf(stderr, "palcas_bench: cannot write %s\n", out_path.c_str());
     return 1;

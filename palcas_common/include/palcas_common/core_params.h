@@ -65,6 +65,7 @@ inline PdqnConfig loadPdqnConfig(palcas::common::ParamReader& p, const std::stri
   c.param_loss_accelerate_only =
       p.get<bool>(k + "param_loss_accelerate_only", c.param_loss_accelerate_only);
   c.epsilon_linear_rounds = p.number(k + "epsilon_linear_rounds", c.epsilon_linear_rounds, 0.0, 1e15);
+  c.bf16_products = p.get<bool>(k + "bf16_products", c.bf16_products);
   c.seed = static_cast<std::uint64_t>(p.integer(k + "seed", static_cast<int>(c.seed), 0, BIG));
   try {
     PdqnConfig checked = c;  // a state size left to the road is checked once it is known

@@ -222,6 +222,20 @@ UpdateStats PdqnAgent::update() {
                              std::to_string(replay_.size()) + " transitions, a batch needs " +
                              std::to_string(config_.batch_size));
   replay_.sample(static_cast<size_t>(config_.batch_size), *rng_, batch_);
+  // bf16_products: the step's products in bfloat16, switched off again however it ends, so
+  // act()'s decisions always run in float.
+  struct Bf16Scope {
+    std::vector<nn::Network*> nets;
+    explicit Bf16Scope(std::vector<nn::Network*> n) : nets(std::move(n)) {
+      for (nn::Network* net : nets) net->setBf16Products(true);
+    }
+    ~Bf16Scope() {
+      for (nn::Network* net : nets) net->setBf16Products(false);
+    }
+  };
+  std::vector<nn::Network*> bf16_nets;
+  if (config_.bf16_products) bf16_nets = {&mu_, &q_, &mu_target_, &q_target_};
+  const Bf16Scope bf16_scope(std::move(bf16_nets));
   UpdateStats stats;
   stats.q_loss = updateQ();
   stats.param_loss = updateParam();

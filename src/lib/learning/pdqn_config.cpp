@@ -5,6 +5,7 @@
 #include <string>
 
 #include "palcas_core/common/checks.h"
+#include "palcas_core/learning/nn/bf16_gemm.h"
 
 namespace palcas {
 
@@ -20,6 +21,8 @@ void PdqnConfig::validate() const {
   require(!hidden_sizes.empty(), "hidden_sizes", hidden_sizes.size(), "needs >= 1 layer");
   for (int h : hidden_sizes) require(h >= 1, "hidden_sizes", h, "entries must be >= 1");
   require(dropout >= 0 && dropout < 1, "dropout", dropout, "must be in [0, 1)");
+  require(!bf16_products || nn::bf16GemmAvailable(), "bf16_products", bf16_products,
+          "needs a build with AVX-512 BF16 (this one was built for a CPU without it)");
   require(huber_delta > 0 && std::isfinite(huber_delta), "huber_delta", huber_delta, "must be > 0");
   require(learning_rate >= 0 && std::isfinite(learning_rate), "learning_rate", learning_rate,
           "must be >= 0");

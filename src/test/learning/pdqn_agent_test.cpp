@@ -11,6 +11,7 @@
 
 #include "common/throws_naming.h"
 #include "learning/checkpoint_without_masks.h"
+#include "palcas_core/learning/nn/bf16_gemm.h"
 #include "palcas_core/learning/nn/serialization.h"
 
 using namespace palcas;
@@ -593,4 +594,57 @@ TEST(PdqnDepartures, LinearEpsilonReachesItsFloorAfterTheStatedRounds) {
   }
   agent.act(s, false);  // greedy rounds do not count
   EXPECT_NEAR(agent.epsilon(), 0.2, 1e-12);
+}
+
+TEST(PdqnAgent, Bf16ProductsChangeTheUpdatesOnlyByBfloat16sPrecisionAndNeverTheDecisions) {
+  if (!nn::bf16GemmAvailable()) {
+    PdqnConfig c = smallConfig();
+    c.bf16_products = true;
+    EXPECT_THROW(c.validate(), std::invalid_argument);
+    GTEST_SKIP() << "built for a CPU without AVX-512 BF16";
+  }
+  Eigen::setNbThreads(1);
+  // Hidden layers that fit the bf16 tiles (64 x 64), a batch of 32.
+  PdqnConfig c = smallConfig(21);
+  c.hidden_sizes = {64, 64};
+  c.batch_size = 32;
+  PdqnConfig low_c = c;
+  low_c.bf16_products = true;
+  PdqnAgent plain(c), low(low_c), other_data(c);
+  const auto weights = [](const PdqnAgent& a) {
+    const std::vector<float> v = a.exportModel().values;
+    return Eigen::Map<const Vector>(v.data(), static_cast<Index>(v.size())).eval();
+  };
+  const Vector start = weights(plain);
+  ASSERT_EQ(weights(low), start);
+  fillReplay(plain, 128, 8);
+  fillReplay(low, 128, 8);
+  fillReplay(other_data, 128, 9);  // the same start trained on other transitions: a real difference
+  for (int i = 0; i < 20; ++i) {
+    plain.update();
+    low.update();
+    other_data.update();
+  }
+  const Vector moved = weights(plain) - start;
+  // Measured: bf16 0.007 of the float steps' movement, other transitions 0.25.
+  const double low_off = (weights(low) - weights(plain)).norm() / moved.norm();
+  const double data_off = (weights(other_data) - weights(plain)).norm() / moved.norm();
+  EXPECT_GT(low_off, 0.0) << "bf16 products: not the float updates";
+  EXPECT_LT(low_off, 0.03) << "20 bf16 steps moved the weights " << low_off << " of the float steps' way off";
+  EXPECT_GT(data_off, 0.1) << "the bound must be able to fail: other data moves them " << data_off;
+
+  // The decisions after the steps are the float network's: the same as a float agent holding
+  // the bf16-trained model.
+  PdqnAgent float_copy(c);
+  float_copy.importModel(low.exportModel());
+  Rng data(4);
+  const Matrix states = randomStates(c.state_size, 16, data);
+  std::vector<Decision> from_low, from_float;
+  low.act(states, false, from_low);
+  float_copy.act(states, false, from_float);
+  ASSERT_EQ(from_low.size(), from_float.size());
+  for (size_t j = 0; j < from_low.size(); ++j) {
+    EXPECT_EQ(from_low[j].action, from_float[j].action);
+    EXPECT_EQ(from_low[j].accel_mps2, from_float[j].accel_mps2);
+  }
 }

@@ -53,6 +53,11 @@ struct PdqnConfig {
   /// exploring decision rounds (./palcas train sets it to a fraction of the training
   /// budget). 0 (paper): geometric decay by epsilon_decay per round.
   double epsilon_linear_rounds = 0.0;
+  /// true: the gradient step's matrix products (every network's forward and backward passes
+  /// inside update()) run in bfloat16 with float sums where the layer shapes fit
+  /// (nn::Linear::setBf16Products); decisions, the optimiser and the stored model stay float.
+  /// Needs a build with AVX-512 BF16. false (paper, float): every product in float.
+  bool bf16_products = false;
 
   /// Throws std::invalid_argument naming the first invalid field and its value.
   void validate() const;

@@ -49,22 +49,37 @@ float roundToBf16(float x) {
   return out;
 }
 
-Bf16Weights packBf16(const Matrix& w) {
-  requireAvailable("packBf16");
-  if (w.rows() == 0 || w.rows() % TILE_ROWS != 0 || w.cols() == 0 || w.cols() % 2 != 0)
-    throw std::invalid_argument("packBf16: weights " + shape(w.rows(), w.cols()) +
+static void requirePackShape(const char* what, Index rows, Index cols) {
+  if (rows <= 0 || rows % TILE_ROWS != 0 || cols <= 0 || cols % 2 != 0)
+    throw std::invalid_argument(std::string(what) + ": weights " + shape(rows, cols) +
                                 ": rows must be a positive multiple of 32 and columns of 2");
-  if (!w.allFinite()) throw std::invalid_argument("packBf16: weights " + shape(w.rows(), w.cols()) + " are not finite");
-  Bf16Weights out{w.rows(), w.cols(), {}};
-  out.pairs.resize(static_cast<size_t>(w.rows() * w.cols() / 2));
+}
+
+void packBf16Into(const Scalar* data, Index rows, Index cols, Index row_stride, Index col_stride, Bf16Weights& out) {
+  requireAvailable("packBf16Into");
+  requirePackShape("packBf16Into", rows, cols);
+  out.rows = rows;
+  out.cols = cols;
+  out.pairs.resize(static_cast<size_t>(rows * cols / 2));
   // Panel p (rows 16p..16p+15), column pair k/2: 16 words, word l = (W(16p+l, k), W(16p+l, k+1)).
   uint32_t* dst = out.pairs.data();
-  for (Index p = 0; p < w.rows(); p += 16) {
-    for (Index k = 0; k < w.cols(); k += 2) {
+  for (Index p = 0; p < rows; p += 16) {
+    for (Index k = 0; k < cols; k += 2) {
+      const Scalar* c0 = data + p * row_stride + k * col_stride;
+      const Scalar* c1 = c0 + col_stride;
       for (Index l = 0; l < 16; ++l)
-        *dst++ = static_cast<uint32_t>(bf16Bits(w(p + l, k))) | (static_cast<uint32_t>(bf16Bits(w(p + l, k + 1))) << 16);
+        *dst++ = static_cast<uint32_t>(bf16Bits(c0[l * row_stride])) |
+                 (static_cast<uint32_t>(bf16Bits(c1[l * row_stride])) << 16);
     }
   }
+}
+
+Bf16Weights packBf16(const Matrix& w) {
+  requireAvailable("packBf16");
+  requirePackShape("packBf16", w.rows(), w.cols());
+  if (!w.allFinite()) throw std::invalid_argument("packBf16: weights " + shape(w.rows(), w.cols()) + " are not finite");
+  Bf16Weights out;
+  packBf16Into(w.data(), w.rows(), w.cols(), 1, w.rows(), out);
   return out;
 }
 

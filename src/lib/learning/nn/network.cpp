@@ -162,6 +162,11 @@ void Network::setRng(Rng* rng) {
   for (auto& layer : layers_) layer->setRng(rng);
 }
 
+void Network::setBf16Products(bool on) {
+  for (auto& layer : layers_)
+    if (auto* linear = dynamic_cast<Linear*>(layer.get())) linear->setBf16Products(on);
+}
+
 Network makeMlp(const MlpSpec& spec, Rng& init_rng) {
   if (spec.input_size < 1 || spec.output_size < 1)
     throw std::invalid_argument("makeMlp: input and output sizes must be >= 1");

@@ -10,6 +10,7 @@
 
 #include "common/throws_naming.h"
 #include "nn_test_util.h"
+#include "palcas_core/learning/nn/linear.h"
 
 using namespace palcas::nn;
 using palcas::nn::test::randomMatrix;
@@ -85,4 +86,65 @@ TEST(Bf16Gemm, RefusesShapesItCannotRunNamingThem) {
   palcas_test::expectThrowNaming<std::invalid_argument>([&] { bf16Gemm(w, Matrix::Ones(4, 5), out, scratch); },
                                                         "input 4 x 5");
   EXPECT_EQ(out, Matrix::Constant(2, 2, 7.0f)) << "a refused product leaves its output alone";
+}
+
+namespace {
+
+// Largest |a - b| over two equally shaped matrices.
+float worstDifference(const Matrix& a, const Matrix& b) { return (a - b).cwiseAbs().maxCoeff(); }
+
+}  // namespace
+
+TEST(Bf16Linear, ComputesItsThreeProductsFromBfloat16InputsWithFloatSums) {
+  if (!bf16GemmAvailable()) GTEST_SKIP() << "built for a CPU without AVX-512 BF16";
+  palcas::Rng rng(3);
+  Linear plain(256, 64, rng);
+  Linear low = plain;
+  low.setBf16Products(true);
+  const Matrix x = randomMatrix(256, 16, rng), g = randomMatrix(64, 16, rng);
+  const Matrix y_plain = plain.forward(x, true), y_low = low.forward(x, true);
+  const Matrix dx_plain = plain.backward(g, {true, 0}), dx_low = low.backward(g, {true, 0});
+  // The products of the rounded inputs in double: what the bf16 path must equal to float rounding.
+  const Matrix w = plain.weight();
+  const auto rounded = [](const Matrix& m) { return roundedToBf16(m).cast<double>().eval(); };
+  const Eigen::MatrixXd y_ref = (rounded(w) * rounded(x)).colwise() + plain.bias().cast<double>();
+  const Eigen::MatrixXd dw_ref = rounded(g) * rounded(x).transpose();
+  const Eigen::MatrixXd dx_ref = rounded(w).transpose() * rounded(g);
+  const Eigen::Map<const Matrix> dw_low(low.gradients().data(), 64, 256);
+  const Eigen::Map<const Matrix> dw_plain(plain.gradients().data(), 64, 256);
+  const double tight = 1e-5 * std::sqrt(256.0);
+  EXPECT_LT((y_low.cast<double>() - y_ref).cwiseAbs().maxCoeff(), tight);
+  EXPECT_LT((dw_low.cast<double>() - dw_ref).cwiseAbs().maxCoeff(), 1e-5 * std::sqrt(16.0));
+  EXPECT_LT((dx_low.cast<double>() - dx_ref).cwiseAbs().maxCoeff(), 1e-5 * std::sqrt(64.0));
+  // ... and differ from the float products by bfloat16's precision, not more.
+  for (const auto& [low_m, plain_m, depth] :
+       {std::tuple<Matrix, Matrix, double>{y_low, y_plain, 256}, {dw_low, dw_plain, 16}, {dx_low, dx_plain, 64}}) {
+    EXPECT_GT(worstDifference(low_m, plain_m), 1e-4 * std::sqrt(depth));
+    EXPECT_LT(worstDifference(low_m, plain_m), 0.02 * std::sqrt(depth));
+  }
+  // The bias gradient is a sum, not a product: float either way.
+  EXPECT_EQ(low.gradients().tail(64), plain.gradients().tail(64));
+}
+
+TEST(Bf16Linear, ShapesOutsideItsTilesStayFloatBitForBit) {
+  if (!bf16GemmAvailable()) {
+    palcas::Rng rng(1);
+    Linear layer(4, 32, rng);
+    palcas_test::expectThrowNaming<std::logic_error>([&] { layer.setBf16Products(true); }, "AVX-512 BF16");
+    return;
+  }
+  // The networks' first layers (45 or 49 inputs), an odd batch, and the heads (1 or 4
+  // outputs), whose input gradient (rows 256, depth 4) is the one product that fits.
+  for (const auto& [in, out, batch] : {std::tuple<Index, Index, Index>{45, 256, 16}, {64, 64, 9}, {256, 4, 16}}) {
+    palcas::Rng rng(5);
+    Linear plain(in, out, rng);
+    Linear low = plain;
+    low.setBf16Products(true);
+    const Matrix x = randomMatrix(in, batch, rng), g = randomMatrix(out, batch, rng);
+    EXPECT_EQ(low.forward(x, true), plain.forward(x, true)) << in << " x " << out;
+    const Matrix dx_low = low.backward(g, {true, 0}), dx_plain = plain.backward(g, {true, 0});
+    EXPECT_EQ(low.gradients(), plain.gradients()) << in << " x " << out;
+    if (out % 2 != 0 || in % 32 != 0 || batch % 8 != 0) EXPECT_EQ(dx_low, dx_plain) << in << " x " << out;
+    else EXPECT_NE(dx_low, dx_plain) << "the head's input gradient fits the tiles";
+  }
 }

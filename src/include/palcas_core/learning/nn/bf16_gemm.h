@@ -1,9 +1,9 @@
 #pragma once
-// A bfloat16 matrix product with float accumulation (AVX-512 BF16), for measuring what lower
-// precision could buy the gradient step (issue "Training at the simulator's speed"): the
-// benchmark times it against Eigen's float product on the network's largest layer. Nothing
-// in the learning uses it: a bf16 update changes the updates, which must first be shown not
-// to change the learning (docs/journal/experiments.md, "What bfloat16 could buy the step").
+// A bfloat16 matrix product with float accumulation (AVX-512 BF16). The benchmark times it
+// against Eigen's float product on the network's largest layer; Linear uses it for the
+// gradient step's products when asked (learning/bf16_products, off by default: a bf16 update
+// differs from the float one by bfloat16's precision, docs/journal/experiments.md, "What
+// bfloat16 could buy the step").
 
 #include <cstdint>
 #include <vector>
@@ -29,6 +29,12 @@ struct Bf16Weights {
 /// Packs W. Throws std::invalid_argument naming the shape unless rows is a multiple of 32 and
 /// cols of 2 and W is finite; std::logic_error when !bf16GemmAvailable().
 Bf16Weights packBf16(const Matrix& w);
+
+/// The same packing of a rows x cols matrix read as data[i * row_stride + k * col_stride]
+/// (a column-major matrix: 1, rows; its transpose: rows, 1) into `out`, reusing its storage.
+/// Non-finite entries stay non-finite (no check: the float product would carry them too).
+/// Throws like packBf16 on the shape.
+void packBf16Into(const Scalar* data, Index rows, Index cols, Index row_stride, Index col_stride, Bf16Weights& out);
 
 /// out = W x with W's and x's entries rounded to bfloat16 and the sums in float (out is
 /// resized to W.rows x x.cols). x: W.cols x batch, batch a multiple of 8. `x_scratch` holds

@@ -1,6 +1,10 @@
 #pragma once
 // Fully connected layer y = W x + b (W: out x in, b: out).
 
+#include <cstdint>
+#include <vector>
+
+#include "palcas_core/learning/nn/bf16_gemm.h"
 #include "palcas_core/learning/nn/layer.h"
 
 namespace palcas::nn {
@@ -26,10 +30,23 @@ class Linear : public Layer {
   }
   Eigen::Map<Vector> bias() { return Eigen::Map<Vector>(params_.data() + out_ * in_, out_); }
 
+  /// true: forward and backward passes compute their products W x, G x^T and W^T G in
+  /// bfloat16 with float sums (bf16Gemm) wherever the shapes fit its tiles (outputs a
+  /// multiple of 32, inputs of 8, batch of 8; other products stay float). PdqnAgent turns it
+  /// on for its gradient steps only, so its decisions stay float. Throws std::logic_error
+  /// when turned on in a build without AVX-512 BF16.
+  void setBf16Products(bool on);
+  bool bf16Products() const { return bf16_; }
+
  private:
   Index in_, out_;
   const Matrix* input_ = nullptr;
   Matrix output_, grad_input_;
+  bool bf16_ = false;
+  // bf16 scratch, reused between calls: packed W, W^T or G, x in bf16, x^T, a product.
+  Bf16Weights packed_;
+  std::vector<uint16_t> bf16_x_;
+  Matrix input_t_, product_;
 };
 
 }  // namespace palcas::nn

@@ -77,6 +77,8 @@ class Network {
   uint64_t layoutChecksum() const;
   /// Random source for the dropout layers (not owned; must outlive the network's use).
   void setRng(Rng* rng);
+  /// Linear::setBf16Products on every Linear layer (not a state change: the values stay).
+  void setBf16Products(bool on);
 
   /// Identifies this network's parameters and buffers as they are now: a value no other
   /// network or earlier state of this one had. Changes on addLayer, setParameters,
