@@ -225,17 +225,18 @@ UpdateStats PdqnAgent::update() {
   // bf16_products: the step's products in bfloat16, switched off again however it ends, so
   // act()'s decisions always run in float.
   struct Bf16Scope {
-    std::vector<nn::Network*> nets;
-    explicit Bf16Scope(std::vector<nn::Network*> n) : nets(std::move(n)) {
-      for (nn::Network* net : nets) net->setBf16Products(true);
+    PdqnAgent& agent;
+    bool on;
+    void set(bool value) const {
+      for (nn::Network* net : {&agent.mu_, &agent.q_, &agent.mu_target_, &agent.q_target_})
+        net->setBf16Products(value);
     }
     ~Bf16Scope() {
-      for (nn::Network* net : nets) net->setBf16Products(false);
+      if (on) set(false);
     }
   };
-  std::vector<nn::Network*> bf16_nets;
-  if (config_.bf16_products) bf16_nets = {&mu_, &q_, &mu_target_, &q_target_};
-  const Bf16Scope bf16_scope(std::move(bf16_nets));
+  const Bf16Scope bf16_scope{*this, config_.bf16_products};
+  if (bf16_scope.on) bf16_scope.set(true);
   UpdateStats stats;
   stats.q_loss = updateQ();
   stats.param_loss = updateParam();
