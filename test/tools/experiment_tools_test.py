@@ -932,6 +932,8 @@ class OverrideUnionsTest(unittest.TestCase):
             "docs/experiment/exit_rule_dev/combination_exit_rule.yaml", "docs/experiment/exit_rule_dev/late_exit_rule.yaml"],
         "config/training/personal_heads_bf16.yaml": ["config/training/personal_heads.yaml",
                                                      "config/training/bf16_products.yaml"],
+        "config/training/personal_heads_half.yaml": ["config/training/personal_heads.yaml",
+                                                     "config/training/half_gradient_steps.yaml"],
         "config/training/bf16_half_gradient_steps.yaml": ["config/training/bf16_products.yaml",
                                                           "config/training/half_gradient_steps.yaml"],
         "docs/experiment/exit_rule_dev/combination_light_exit_rule.yaml": [
