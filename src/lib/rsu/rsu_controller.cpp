@@ -63,6 +63,11 @@ void RsuControllerOptions::validate() const {
   require(std::isfinite(exit_rule_below_density_veh_per_km) && exit_rule_below_density_veh_per_km >= 0.0,
           "exit_rule_below_density_veh_per_km", exit_rule_below_density_veh_per_km,
           "must be finite and >= 0 (0 = at any density)");
+  require(std::isfinite(exit_rule_density_window_s) && exit_rule_density_window_s >= 0.0,
+          "exit_rule_density_window_s", exit_rule_density_window_s, "must be finite and >= 0 (0 = no window)");
+  require(exit_rule_density_window_s == 0.0 || exit_rule_below_density_veh_per_km > 0.0,
+          "exit_rule_density_window_s", exit_rule_density_window_s,
+          "needs exit_rule_below_density_veh_per_km > 0 (a window of a density no limit reads does nothing)");
   require(std::isfinite(lane_change_cost) && lane_change_cost >= 0.0, "lane_change_cost", lane_change_cost,
           "must be finite and >= 0 (it is subtracted; 0 = off)");
   nested("rules", [&] { rules.validate(); });
@@ -367,8 +372,7 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   }
   const double lane_density_veh_per_km = obs.cluster.density_veh_per_km / options_.num_lanes;
   const bool exit_rule_acts =
-      options_.exit_rule_override && (options_.exit_rule_below_density_veh_per_km <= 0.0 ||
-                                      lane_density_veh_per_km < options_.exit_rule_below_density_veh_per_km);
+      exitRuleLightTraffic(lane_density_veh_per_km, time_s) && options_.exit_rule_override;
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
     // The rule advises RIGHT only for an exit-bound CAV's exit, which every mask allows.
@@ -456,6 +460,27 @@ void RsuController::endEpisode() {
   stats_.pending_dropped += book_.dropAll();
   have_last_step_ = false;
   lanes_seen_.clear();
+  density_window_.clear();
+  traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
+}
+
+bool RsuController::exitRuleLightTraffic(double lane_density_veh_per_km, double time_s) {
+  const double limit = options_.exit_rule_below_density_veh_per_km;
+  const double window_s = options_.exit_rule_density_window_s;
+  if (limit <= 0.0) return true;
+  if (window_s <= 0.0) return lane_density_veh_per_km < limit;
+  if (lane_density_veh_per_km <= 0.0) {  // an empty zone: the wait starts again
+    density_window_.clear();
+    traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
+    return false;
+  }
+  if (std::isnan(traffic_since_s_)) traffic_since_s_ = time_s;
+  density_window_.emplace_back(time_s, lane_density_veh_per_km);
+  while (time_s - density_window_.front().first > window_s) density_window_.pop_front();
+  if (time_s - traffic_since_s_ < window_s) return false;
+  double sum = 0.0;
+  for (const auto& sample : density_window_) sum += sample.second;
+  return sum / static_cast<double>(density_window_.size()) < limit;
 }
 
 RsuControllerStats RsuController::stats() const {

@@ -273,3 +273,48 @@ TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsDensity) {
                                                          "exit_rule_below_density_veh_per_km");
   }
 }
+
+TEST(RuleAdvisor, TheExitRuleOverrideWaitsForTheZonesTrafficAndReadsItsWindowsMeanDensity) {
+  RsuControllerOptions o = ruleController();
+  o.advice_source = AdviceSource::kNetwork;
+  o.exit_rule_override = true;
+  o.exit_rule_below_density_veh_per_km = 1.0;
+  o.exit_rule_density_window_s = 10.0;
+  RsuController rsu(o);
+  // 3 vehicles in the 800 m zone of five lanes: 0.75 veh/km per lane; 9 vehicles: 2.25.
+  RoadSnapshot light;
+  light.num_lanes = LANES;
+  light.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  RoadSnapshot busy = light;
+  for (int i = 0; i < 6; ++i) busy.vehicles.push_back(cav("other" + std::to_string(i), 1 + i % 3, 50.0 + 100.0 * i));
+  RoadSnapshot empty;
+  empty.num_lanes = LANES;
+  uint64_t step = 0;
+  const auto nearAction = [&](const RoadSnapshot& road, double time_s) {
+    const std::vector<palcas::Decision> keep(road.vehicles.size(), palcas::Decision{Action::kKeep, 0.0f});
+    const auto out = rsu.adviseWith(road, ++step, time_s, GlobalDensities{}, VehicleOutcomes{}, keep);
+    return out.advisories.size() > 1 ? out.advisories[1].decision.action : Action::kKeep;
+  };
+  for (int t = 1; t <= 10; ++t)
+    EXPECT_EQ(nearAction(light, t), Action::kKeep) << "t " << t << ": the zone has held traffic for less than 10 s";
+  EXPECT_EQ(nearAction(light, 11), Action::kLaneRight) << "10 s of a light zone";
+  EXPECT_EQ(nearAction(busy, 12), Action::kLaneRight) << "the window's mean, (10 x 0.75 + 2.25) / 11, is below 1";
+  EXPECT_EQ(nearAction(busy, 13), Action::kKeep) << "(9 x 0.75 + 2 x 2.25) / 11 is not";
+  nearAction(empty, 14);
+  for (int t = 15; t < 25; ++t)
+    EXPECT_EQ(nearAction(light, t), Action::kKeep) << "t " << t << ": an empty zone started the wait again";
+  EXPECT_EQ(nearAction(light, 25), Action::kLaneRight);
+  step = 0;  // the bridge restarted: a new episode, and a new wait
+  EXPECT_EQ(nearAction(light, 30), Action::kKeep);
+
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    RsuControllerOptions invalid = o;
+    invalid.exit_rule_density_window_s = bad;
+    palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController r(invalid); },
+                                                         "exit_rule_density_window_s");
+  }
+  RsuControllerOptions no_limit = o;
+  no_limit.exit_rule_below_density_veh_per_km = 0.0;
+  palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController r(no_limit); },
+                                                       "exit_rule_density_window_s");
+}

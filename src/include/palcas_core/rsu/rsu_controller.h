@@ -9,9 +9,11 @@
 
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "palcas_core/common/action.h"
@@ -76,6 +78,12 @@ struct RsuControllerOptions {
   /// averaged over its lanes, is below this [veh/km per lane], so it serves exits at light
   /// traffic and leaves a busy road's right lanes alone. >= 0; 0 = at any density.
   double exit_rule_below_density_veh_per_km = 0.0;
+  /// With exit_rule_below_density_veh_per_km: the density read against that limit is the mean
+  /// over this zone's decisions of the last this-many seconds, and the override waits until the
+  /// zone has held traffic for that long (an empty zone starts the wait again). An empty road
+  /// fills at light density at every demand; without the wait the override acts during the
+  /// fill of a road about to be busy. >= 0 [s]; 0 = the density at the decision alone.
+  double exit_rule_density_window_s = 0.0;
   /// Subtracted from the reward of a transition whose advice was a lane change that does not
   /// serve the CAV's route (anything but an exit-bound CAV's change right and the merge off
   /// the acceleration lane): the speed-gain changes a policy makes too many of cost something,
@@ -304,6 +312,9 @@ class RsuController {
   double sinceLaneChange(const VehicleSnapshot& vehicle, double time_s) const;
   /// Remembers every vehicle's lane and when it last changed (only with the dwell on).
   void rememberLanes(const RoadSnapshot& snapshot, double time_s);
+  /// Adds this decision's lane density to the exit rule's window; whether the zone counts as
+  /// light traffic for the exit rule override now.
+  bool exitRuleLightTraffic(double lane_density_veh_per_km, double time_s);
   std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
                                                       const MemberColumns& columns,
                                                       const PendingFates& fates,
@@ -325,6 +336,10 @@ class RsuController {
   PdqnAgent agent_;
   std::vector<nn::Network::StateSpan> personal_head_;  ///< kept from the local model on loadGlobalModel
   TransitionBook book_;  // pending decisions and limbo
+  /// The exit rule's density window: (decision time [s], lane density [veh/km]) of the zone's
+  /// decisions since traffic_since_s_, the last exit_rule_density_window_s seconds of them.
+  std::deque<std::pair<double, double>> density_window_;
+  double traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
   struct LaneSeen {
