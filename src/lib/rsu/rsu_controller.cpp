@@ -372,7 +372,7 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
   }
   const double lane_density_veh_per_km = obs.cluster.density_veh_per_km / options_.num_lanes;
   const bool exit_rule_acts =
-      exitRuleLightTraffic(lane_density_veh_per_km, time_s) && options_.exit_rule_override;
+      options_.exit_rule_override && exitRuleLightTraffic(lane_density_veh_per_km, time_s);
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
     // The rule advises RIGHT only for an exit-bound CAV's exit, which every mask allows.
@@ -460,6 +460,10 @@ void RsuController::endEpisode() {
   stats_.pending_dropped += book_.dropAll();
   have_last_step_ = false;
   lanes_seen_.clear();
+  resetDensityWindow();
+}
+
+void RsuController::resetDensityWindow() {
   density_window_.clear();
   traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
 }
@@ -470,8 +474,7 @@ bool RsuController::exitRuleLightTraffic(double lane_density_veh_per_km, double 
   if (limit <= 0.0) return true;
   if (window_s <= 0.0) return lane_density_veh_per_km < limit;
   if (lane_density_veh_per_km <= 0.0) {  // an empty zone: the wait starts again
-    density_window_.clear();
-    traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
+    resetDensityWindow();
     return false;
   }
   if (std::isnan(traffic_since_s_)) traffic_since_s_ = time_s;

@@ -315,6 +315,8 @@ class RsuController {
   /// Adds this decision's lane density to the exit rule's window; whether the zone counts as
   /// light traffic for the exit rule override now.
   bool exitRuleLightTraffic(double lane_density_veh_per_km, double time_s);
+  /// Forgets the window and the time traffic arrived (a new episode, an empty zone).
+  void resetDensityWindow();
   std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
                                                       const MemberColumns& columns,
                                                       const PendingFates& fates,
