@@ -62,6 +62,9 @@ RsuNodeOptions loadRsuNodeOptions(const ros::NodeHandle& private_nh, common::Par
       p.number("rsu/exit_rule_below_density_veh_per_km", c.exit_rule_below_density_veh_per_km, 0.0, 1e6);
   c.exit_rule_density_window_s =
       p.number("rsu/exit_rule_density_window_s", c.exit_rule_density_window_s, 0.0, 1e6);
+  c.exit_rule_below_inflow_veh_per_h_per_lane = p.number(
+      "rsu/exit_rule_below_inflow_veh_per_h_per_lane", c.exit_rule_below_inflow_veh_per_h_per_lane, 0.0, 1e6);
+  c.exit_rule_inflow_window_s = p.number("rsu/exit_rule_inflow_window_s", c.exit_rule_inflow_window_s, 1e-3, 1e6);
   c.lane_change_cost = p.number("rsu/lane_change_cost", c.lane_change_cost, 0.0, 1e6);
   c.gradient_steps_per_decision =
       p.number("rsu/gradient_steps_per_decision", c.gradient_steps_per_decision, 0.0, 1000.0);

@@ -941,6 +941,9 @@ class OverrideUnionsTest(unittest.TestCase):
         "docs/experiment/exit_rule_dev/combination_windowed_light_exit_rule.yaml": [
             "docs/experiment/exit_rule_dev/combination_light_exit_rule.yaml",
             "docs/experiment/exit_rule_dev/windowed_light_exit_rule.yaml"],
+        "docs/experiment/exit_rule_dev/combination_inflow_exit_rule.yaml": [
+            "docs/experiment/exit_rule_dev/combination_light_exit_rule.yaml",
+            "docs/experiment/exit_rule_dev/inflow_exit_rule.yaml"],
     }
 
     def test_each_union_file_equals_its_parts(self):

@@ -68,6 +68,11 @@ void RsuControllerOptions::validate() const {
   require(exit_rule_density_window_s == 0.0 || exit_rule_below_density_veh_per_km > 0.0,
           "exit_rule_density_window_s", exit_rule_density_window_s,
           "needs exit_rule_below_density_veh_per_km > 0 (a window of a density no limit reads does nothing)");
+  require(std::isfinite(exit_rule_below_inflow_veh_per_h_per_lane) && exit_rule_below_inflow_veh_per_h_per_lane >= 0.0,
+          "exit_rule_below_inflow_veh_per_h_per_lane", exit_rule_below_inflow_veh_per_h_per_lane,
+          "must be finite and >= 0 (0 = any inflow)");
+  require(std::isfinite(exit_rule_inflow_window_s) && exit_rule_inflow_window_s > 0.0, "exit_rule_inflow_window_s",
+          exit_rule_inflow_window_s, "must be finite and > 0");
   require(std::isfinite(lane_change_cost) && lane_change_cost >= 0.0, "lane_change_cost", lane_change_cost,
           "must be finite and >= 0 (it is subtracted; 0 = off)");
   nested("rules", [&] { rules.validate(); });
@@ -371,8 +376,10 @@ DecisionOutput RsuController::adviseImpl(const RoadSnapshot& snapshot, uint64_t 
     agent_.act(obs.member_states, options_.train, decisions);
   }
   const double lane_density_veh_per_km = obs.cluster.density_veh_per_km / options_.num_lanes;
-  const bool exit_rule_acts =
-      options_.exit_rule_override && exitRuleLightTraffic(lane_density_veh_per_km, time_s);
+  // Both gates see every decision, so each keeps its own window whatever the other says.
+  const bool exit_rule_acts = options_.exit_rule_override &&
+                              (exitRuleLightTraffic(lane_density_veh_per_km, time_s) &
+                               exitRuleLowInflow(snapshot, time_s));
   std::vector<ActionMask> allowed(decisions.size());
   for (size_t i = 0; i < decisions.size(); ++i) {
     // The rule advises RIGHT only for an exit-bound CAV's exit, which every mask allows.
@@ -461,6 +468,7 @@ void RsuController::endEpisode() {
   have_last_step_ = false;
   lanes_seen_.clear();
   resetDensityWindow();
+  resetInflowWindow();
 }
 
 void RsuController::resetDensityWindow() {
@@ -484,6 +492,44 @@ bool RsuController::exitRuleLightTraffic(double lane_density_veh_per_km, double 
   double sum = 0.0;
   for (const auto& sample : density_window_) sum += sample.second;
   return sum / static_cast<double>(density_window_.size()) < limit;
+}
+
+void RsuController::resetInflowWindow() {
+  inflow_members_.clear();
+  inflow_window_.clear();
+  inflow_since_s_ = std::numeric_limits<double>::quiet_NaN();
+}
+
+bool RsuController::exitRuleLowInflow(const RoadSnapshot& snapshot, double time_s) {
+  const double limit = options_.exit_rule_below_inflow_veh_per_h_per_lane;
+  if (limit <= 0.0) return true;
+  const double window_s = options_.exit_rule_inflow_window_s;
+  std::unordered_set<std::string> members;
+  uint32_t entered = 0;
+  for (const VehicleSnapshot& v : snapshot.vehicles) {
+    // The zone's mainline lanes, as its density counts them: a ramp vehicle enters on merging.
+    if (v.lane < 1 || v.lane > options_.num_lanes || v.x_m < options_.x_start_m || v.x_m >= options_.x_end_m)
+      continue;
+    members.insert(v.id);
+    if (inflow_members_.count(v.id) == 0) ++entered;
+  }
+  if (members.empty()) {  // an empty zone: the wait starts again
+    resetInflowWindow();
+    return false;
+  }
+  // The decision that first sees traffic starts the wait and counts nothing: its vehicles may
+  // have arrived at any time before it.
+  const bool first = std::isnan(inflow_since_s_);
+  if (first) inflow_since_s_ = time_s;
+  inflow_members_ = std::move(members);
+  if (first) return false;
+  inflow_window_.emplace_back(time_s, entered);
+  while (time_s - inflow_window_.front().first >= window_s) inflow_window_.pop_front();
+  if (time_s - inflow_since_s_ < window_s) return false;
+  uint64_t count = 0;
+  for (const auto& sample : inflow_window_) count += sample.second;
+  const double per_h_per_lane = static_cast<double>(count) * 3600.0 / window_s / options_.num_lanes;
+  return per_h_per_lane < limit;
 }
 
 RsuControllerStats RsuController::stats() const {

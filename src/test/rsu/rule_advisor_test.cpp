@@ -318,3 +318,73 @@ TEST(RuleAdvisor, TheExitRuleOverrideWaitsForTheZonesTrafficAndReadsItsWindowsMe
   palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController r(no_limit); },
                                                        "exit_rule_density_window_s");
 }
+
+TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsZonesInflowCountedOverItsWindow) {
+  RsuControllerOptions o = ruleController();
+  o.advice_source = AdviceSource::kNetwork;
+  o.exit_rule_override = true;
+  // 10 s window, five lanes: 13 vehicles new in the window are 13 x 360 / 5 = 936 veh/h per
+  // lane, below 1000; 14 are 1008, not.
+  o.exit_rule_below_inflow_veh_per_h_per_lane = 1000.0;
+  o.exit_rule_inflow_window_s = 10.0;
+  RsuController rsu(o);
+  RoadSnapshot road;
+  road.num_lanes = LANES;
+  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  const auto human = [](const std::string& id, int lane, double x) {
+    VehicleSnapshot v = cav(id, lane, x);
+    v.is_cav = false;
+    return v;
+  };
+  const auto arrive = [&](const std::string& name, int count, double x_m) {
+    for (int i = 0; i < count; ++i) road.vehicles.push_back(human(name + std::to_string(i), 1 + i % LANES, x_m + 7.0 * i));
+  };
+  uint64_t step = 0;
+  const std::vector<palcas::Decision> keep(3, palcas::Decision{Action::kKeep, 0.0f});
+  const auto nearAction = [&](double time_s) {
+    return rsu.adviseWith(road, ++step, time_s, GlobalDensities{}, VehicleOutcomes{}, keep).advisories[1].decision.action;
+  };
+  EXPECT_EQ(nearAction(1.0), Action::kKeep) << "the first decision with traffic starts the wait and counts nothing";
+  for (int t = 2; t <= 10; ++t) EXPECT_EQ(nearAction(t), Action::kKeep) << "t " << t << ": less than 10 s of traffic";
+  EXPECT_EQ(nearAction(11.0), Action::kLaneRight) << "10 s of traffic, none new";
+  arrive("in_zone", 13, 400.0);
+  arrive("downstream", 4, 820.0);  // beyond the zone's end: not its inflow
+  EXPECT_EQ(nearAction(12.0), Action::kLaneRight) << "13 new in the window: 936 veh/h per lane";
+  arrive("more", 1, 700.0);
+  EXPECT_EQ(nearAction(13.0), Action::kKeep) << "14 new in the window: 1008 veh/h per lane";
+  for (int t = 14; t <= 21; ++t) EXPECT_EQ(nearAction(t), Action::kKeep) << "t " << t << ": 14 still in (t - 10, t]";
+  EXPECT_EQ(nearAction(22.0), Action::kLaneRight) << "the 13 of t = 12 have left the window";
+
+  // Three vehicles back after an empty zone: 216 veh/h per lane if counted, so only the wait
+  // keeps the override off until t = 34.
+  const std::vector<VehicleSnapshot> first_three(road.vehicles.begin(), road.vehicles.begin() + 3);
+  road.vehicles.clear();
+  rsu.adviseWith(road, ++step, 23.0, GlobalDensities{}, VehicleOutcomes{}, {});
+  road.vehicles = first_three;
+  for (int t = 24; t <= 33; ++t)
+    EXPECT_EQ(nearAction(t), Action::kKeep) << "t " << t << ": an empty zone started the wait again";
+  EXPECT_EQ(nearAction(34.0), Action::kLaneRight) << "the wait's first decision counted nothing";
+  step = 0;  // the bridge restarted: a new episode, and a new wait
+  EXPECT_EQ(nearAction(40.0), Action::kKeep);
+
+  RsuControllerOptions dense = o;  // both gates: the density's shuts the override alone
+  dense.exit_rule_below_density_veh_per_km = 0.5;
+  RsuController both(dense);
+  for (int t = 1; t <= 12; ++t) {
+    const auto out = both.adviseWith(road, t, t, GlobalDensities{}, VehicleOutcomes{}, keep);
+    EXPECT_EQ(out.advisories[1].decision.action, Action::kKeep) << "t " << t;
+  }
+
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    RsuControllerOptions invalid = o;
+    invalid.exit_rule_below_inflow_veh_per_h_per_lane = bad;
+    palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController r(invalid); },
+                                                         "exit_rule_below_inflow_veh_per_h_per_lane");
+  }
+  for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    RsuControllerOptions invalid = o;
+    invalid.exit_rule_inflow_window_s = bad;
+    palcas_test::expectThrowNaming<std::invalid_argument>([&] { RsuController r(invalid); },
+                                                         "exit_rule_inflow_window_s");
+  }
+}

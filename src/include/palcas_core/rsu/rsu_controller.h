@@ -13,6 +13,7 @@
 #include <limits>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -84,6 +85,15 @@ struct RsuControllerOptions {
   /// fills at light density at every demand; without the wait the override acts during the
   /// fill of a road about to be busy. >= 0 [s]; 0 = the density at the decision alone.
   double exit_rule_density_window_s = 0.0;
+  /// With exit_rule_override: the override acts only while the zone's inflow, the vehicles that
+  /// appeared on its mainline lanes over the last exit_rule_inflow_window_s seconds, per lane
+  /// and hour, is below this, and not before the zone has held traffic for that window (an
+  /// empty zone starts the wait again). A busy road's demand reaches a zone at close to its full
+  /// rate well before the zone's density rises.
+  /// >= 0 [veh/h per lane]; 0 = any inflow.
+  double exit_rule_below_inflow_veh_per_h_per_lane = 0.0;
+  /// The window the inflow is counted over (> 0 [s]; read only with an inflow limit).
+  double exit_rule_inflow_window_s = 120.0;
   /// Subtracted from the reward of a transition whose advice was a lane change that does not
   /// serve the CAV's route (anything but an exit-bound CAV's change right and the merge off
   /// the acceleration lane): the speed-gain changes a policy makes too many of cost something,
@@ -317,6 +327,11 @@ class RsuController {
   bool exitRuleLightTraffic(double lane_density_veh_per_km, double time_s);
   /// Forgets the window and the time traffic arrived (a new episode, an empty zone).
   void resetDensityWindow();
+  /// Counts the vehicles new on the zone's mainline lanes since the last decision; whether the
+  /// zone's inflow over the window is below the exit rule's limit now (true without a limit).
+  bool exitRuleLowInflow(const RoadSnapshot& snapshot, double time_s);
+  /// Forgets the inflow count and the time traffic arrived (a new episode, an empty zone).
+  void resetInflowWindow();
   std::unordered_map<std::string, StateNow> statesNow(const Observation& obs,
                                                       const MemberColumns& columns,
                                                       const PendingFates& fates,
@@ -342,6 +357,11 @@ class RsuController {
   /// decisions since traffic_since_s_, the last exit_rule_density_window_s seconds of them.
   std::deque<std::pair<double, double>> density_window_;
   double traffic_since_s_ = std::numeric_limits<double>::quiet_NaN();
+  /// The exit rule's inflow count: the zone's mainline vehicles at the last decision, and
+  /// (decision time [s], vehicles new since the decision before) since inflow_since_s_.
+  std::unordered_set<std::string> inflow_members_;
+  std::deque<std::pair<double, uint32_t>> inflow_window_;
+  double inflow_since_s_ = std::numeric_limits<double>::quiet_NaN();
   bool have_last_step_ = false;
   uint64_t last_step_ = 0;
   struct LaneSeen {
