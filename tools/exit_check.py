@@ -34,6 +34,9 @@ def metrics_files(root):
         raise ExitCheckError(f"{root}: no such folder")
     files = [root / "metrics.json"] if (root / "metrics.json").is_file() else []
     files += sorted(root.rglob("*/metrics.json"))
+    # An experiment's figures/runs/<arm>/ holds a copy of one point's run for its figures.
+    if (root / "points").is_dir():
+        files = [f for f in files if f.relative_to(root).parts[0] != "figures"]
     # A training folder's own metrics.json repeats its last episode_<k>/metrics.json.
     return [f for f in files if not any(f.parent.glob("episode_*/metrics.json"))]
 

@@ -790,8 +790,8 @@ class LaneChangeBreakdownTest(unittest.TestCase):
 
 class ExitCheckTest(unittest.TestCase):
     """tools/exit_check.py on hand-made metrics.json: each exit's CAVs pooled over seeds, the
-    worst seed found, a low exit failing --min-served-pct, a training's duplicate skipped, and
-    files that are not ours refused by name."""
+    worst seed found, a low exit failing --min-served-pct, a training's duplicate and an
+    experiment's figure copy skipped, and files that are not ours refused by name."""
 
     def run_folder(self, root, point, arm, seed, exits, pr=60, demand=1000):
         d = root / "points" / point / arm
@@ -833,6 +833,14 @@ class ExitCheckTest(unittest.TestCase):
         with contextlib.redirect_stdout(io.StringIO()):
             self.assertEqual(exit_check.main([str(self.root), "--min-served-pct", "50", "--csv", str(out)]), 0)
         self.assertEqual(len(list(csv.reader(out.open()))), 1 + 6)
+
+    def test_an_experiments_figure_copy_of_a_point_is_not_counted_again(self):
+        figure_run = self.root / "figures" / "runs" / "palcas"
+        figure_run.mkdir(parents=True)
+        shutil.copy(self.root / "points" / "palcas_s101" / "palcas" / "metrics.json", figure_run)
+        rows = {(r[0], r[3]): r for r in exit_check.check([self.root])}
+        self.assertEqual(rows[("palcas", 1)][4], 2)
+        self.assertEqual(rows[("palcas", 1)][5]["served"], 10)
 
     def test_a_trainings_own_metrics_repeats_its_last_episode_and_is_skipped(self):
         d = self.root / "train" / "palcas"
