@@ -218,6 +218,27 @@ TEST(RuleAdvisor, AResidualOnKeepAdvisesKeepUntilDepartingPaysByTheMargin) {
   EXPECT_EQ(actions(residual), alone);
 }
 
+namespace {
+
+/// The rule controller advising from its network, the rule's exit service overriding it.
+RsuControllerOptions overriddenNetwork() {
+  RsuControllerOptions o = ruleController();
+  o.advice_source = AdviceSource::kNetwork;
+  o.exit_rule_override = true;
+  return o;
+}
+
+/// exit_far (lane 4, 2000 m to its exit), exit_near (lane 4, 500 m: the rule's one RIGHT) and a
+/// through CAV, all in the zone.
+RoadSnapshot exitBoundAndThrough() {
+  RoadSnapshot road;
+  road.num_lanes = LANES;
+  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  return road;
+}
+
+}  // namespace
+
 TEST(RuleAdvisor, TheExitRuleOverrideSendsTheRulesExitBoundCavsRightWhateverTheNetworkSaid) {
   RsuControllerOptions network = ruleController();
   network.advice_source = AdviceSource::kNetwork;
@@ -231,9 +252,7 @@ TEST(RuleAdvisor, TheExitRuleOverrideSendsTheRulesExitBoundCavsRightWhateverTheN
   EXPECT_EQ(residualActions(overridden), expected) << "only exit_near's advice changes";
 
   // Decisions from outside (the batched learner's adviseWith) get the same override.
-  RoadSnapshot road;
-  road.num_lanes = LANES;
-  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  RoadSnapshot road = exitBoundAndThrough();
   const std::vector<palcas::Decision> keep(3, palcas::Decision{Action::kKeep, 0.0f});
   const auto actions = [&](const RsuControllerOptions& o) {
     RsuController rsu(o);
@@ -247,12 +266,8 @@ TEST(RuleAdvisor, TheExitRuleOverrideSendsTheRulesExitBoundCavsRightWhateverTheN
 }
 
 TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsDensity) {
-  RsuControllerOptions overridden = ruleController();
-  overridden.advice_source = AdviceSource::kNetwork;
-  overridden.exit_rule_override = true;
-  RoadSnapshot road;
-  road.num_lanes = LANES;
-  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  const RsuControllerOptions overridden = overriddenNetwork();
+  RoadSnapshot road = exitBoundAndThrough();
   // Three vehicles in an 800 m zone of five lanes: 3 / 0.8 / 5 = 0.75 veh/km per lane.
   const std::vector<palcas::Decision> keep(3, palcas::Decision{Action::kKeep, 0.0f});
   const auto nearAction = [&](double below) {
@@ -275,16 +290,12 @@ TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsDensity) {
 }
 
 TEST(RuleAdvisor, TheExitRuleOverrideWaitsForTheZonesTrafficAndReadsItsWindowsMeanDensity) {
-  RsuControllerOptions o = ruleController();
-  o.advice_source = AdviceSource::kNetwork;
-  o.exit_rule_override = true;
+  RsuControllerOptions o = overriddenNetwork();
   o.exit_rule_below_density_veh_per_km = 1.0;
   o.exit_rule_density_window_s = 10.0;
   RsuController rsu(o);
   // 3 vehicles in the 800 m zone of five lanes: 0.75 veh/km per lane; 9 vehicles: 2.25.
-  RoadSnapshot light;
-  light.num_lanes = LANES;
-  light.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  RoadSnapshot light = exitBoundAndThrough();
   RoadSnapshot busy = light;
   for (int i = 0; i < 6; ++i) busy.vehicles.push_back(cav("other" + std::to_string(i), 1 + i % 3, 50.0 + 100.0 * i));
   RoadSnapshot empty;
@@ -320,17 +331,13 @@ TEST(RuleAdvisor, TheExitRuleOverrideWaitsForTheZonesTrafficAndReadsItsWindowsMe
 }
 
 TEST(RuleAdvisor, TheExitRuleOverrideActsOnlyBelowItsZonesInflowCountedOverItsWindow) {
-  RsuControllerOptions o = ruleController();
-  o.advice_source = AdviceSource::kNetwork;
-  o.exit_rule_override = true;
+  RsuControllerOptions o = overriddenNetwork();
   // 10 s window, five lanes: 13 vehicles new in the window are 13 x 360 / 5 = 936 veh/h per
   // lane, below 1000; 14 are 1008, not.
   o.exit_rule_below_inflow_veh_per_h_per_lane = 1000.0;
   o.exit_rule_inflow_window_s = 10.0;
   RsuController rsu(o);
-  RoadSnapshot road;
-  road.num_lanes = LANES;
-  road.vehicles = {cav("exit_far", 4, 100.0, 2000.0), cav("exit_near", 4, 300.0, 500.0), cav("through", 3, 600.0)};
+  RoadSnapshot road = exitBoundAndThrough();
   const auto human = [](const std::string& id, int lane, double x) {
     VehicleSnapshot v = cav(id, lane, x);
     v.is_cav = false;
