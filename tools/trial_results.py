@@ -14,9 +14,11 @@ seeds, seed_set, duration_s, scenario, bridge_params, policies; and note, date, 
 printed as they are; seeds_by_demand, {"1400": [seeds], ...}, for a part run with fewer seeds
 than the trial's list). Sections of their own, each from its key: federation {reference, arms}
 (the same training budget, another scheme; reference_what describes the reference), variants
-{arm: {base, what, ships, replaced_as}} (a learned arm's policy run another way; with ships
+{arm: {base, what, ships, replaced_as, own_control}} (a learned arm's policy run another way; with ships
 true, the way the base arm's shipped policy now runs, which the targets and the federation table
-read in place of the base's own rows; the federation table keeps those under replaced_as),
+read in place of the base's own rows; the federation table keeps those under replaced_as;
+own_control {arm, what}: the rows of the variant's hand-made mechanisms without its network, a
+control of that variant, paired with it and with the best control),
 trainings {reference, arms: {arm: {seed, what}}, alternatives: {name: {what, arms, against}},
 configuration} (the shipped configuration trained from other seeds, or the one `configuration`
 names; another configuration trained from several seeds, compared training by training with
@@ -586,6 +588,12 @@ def what_was_run(rows, files, settings, folder, a):
         lines.append(f"- Variants chosen on the development seeds: {len(var_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in var_rows}))
                      + f" ({sum(1 for r in var_rows if r['status'] == 'done')} finished)")
+    own_arms = {c["arm"] for c in own_controls(settings).values()}
+    own_rows = [r for r in rows if r["arm"] in own_arms]
+    if own_rows:
+        lines.append(f"- Variants' own controls (their hand-made mechanisms without the network): {len(own_rows)} rows of "
+                     + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in own_rows}))
+                     + f" ({sum(1 for r in own_rows if r['status'] == 'done')} finished)")
     tr_rows = [r for r in rows if r["arm"] in training_arms(settings) and r["arm"] != training_reference(settings)]
     if tr_rows:
         lines.append(f"- Trainings of the shipped configuration from other seeds: {len(tr_rows)} rows of "
@@ -734,6 +742,26 @@ def variant_arms(settings):
     return dict(settings.get("variants") or {})
 
 
+def own_controls(settings):
+    """{variant: {"arm": rows name, "what": text}} of the variants that name an `own_control`: the
+    variant's hand-made mechanisms run with its network's choice replaced by a fixed one, so that
+    every mechanism the variant gets that is not learned is in a control too. Its rows are a
+    control of that variant only, not of the trial's cells."""
+    variants = variant_arms(settings)
+    out = {}
+    for arm, v in variants.items():
+        own = v.get("own_control")
+        if own is None:
+            continue
+        name = (own.get("arm") or "").strip() if isinstance(own, dict) else ""
+        if not name or not (own.get("what") or "").strip():
+            raise TrialError(f"trial.json variants: '{arm}' own_control needs an arm and a what")
+        if name == arm or name in variants:
+            raise TrialError(f"trial.json variants: '{arm}' own_control '{name}' is a variant, not a control")
+        out[arm] = {"arm": name, "what": own["what"].strip()}
+    return out
+
+
 def shipped_variants(settings):
     """{base arm: variant} of the variants trial.json marks `"ships": true`: the way the base
     arm's shipped policy now runs (its policy folder's rsu.yaml, say), so that the targets read
@@ -812,7 +840,8 @@ def alternative_arms(settings):
 def extra_arms(settings):
     """Arms shown in a section of their own, not in the planned grid."""
     retrained = (set(training_arms(settings)) | alternative_arms(settings)) - {training_reference(settings)}
-    return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained
+    own = {c["arm"] for c in own_controls(settings).values()}
+    return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained | own
 
 
 FEDERATION_METRICS = ["dsr", "lane_changes_per_cav", "throughput_vph", "total_time_spent_veh_h"]
@@ -855,9 +884,12 @@ def paired_entry(rows, cell, left, right, metrics, best):
 
 
 def analyse_variants(rows, settings, a):
-    """Each variant against the cell's best control (every paired metric) and against its
-    base arm (speed and the metrics the base differs in), per cell where it has rows."""
+    """Each variant against the cell's best control (every paired metric), against its own
+    control where it names one (every paired metric; and that control against the best control
+    on speed) and against its base arm (speed and the metrics the base differs in), per cell
+    where it has rows."""
     variants = variant_arms(settings)
+    own = own_controls(settings)
     best = {x["cell"]: x["best"] for x in a["cells"]}
     out = []
     for cell in cells_of([r for r in rows if r["arm"] in variants]):
@@ -868,6 +900,10 @@ def analyse_variants(rows, settings, a):
             e = {"arm": arm, "what": variants[arm].get("what", ""), "base": variants[arm].get("base", "")}
             if best.get(cell):
                 e["vs_best"] = dict(paired_entry(rows, cell, arm, best[cell], PAIRED, None), control=best[cell])
+            ctl = own.get(arm, {}).get("arm")
+            if ctl and done_rows(rows, ctl, cell):
+                e["vs_own"] = dict(paired_entry(rows, cell, arm, ctl, PAIRED, best.get(cell)), control=ctl,
+                                   control_what=own[arm]["what"])
             if e["base"] and done_rows(rows, e["base"], cell):
                 e["vs_base"] = paired_entry(rows, cell, arm, e["base"], FEDERATION_METRICS, None)
             e["own"] = arm_cell(rows, arm, cell)
@@ -1096,25 +1132,36 @@ def variants_section(var):
     lines = ["", "## Learned variants chosen on the development seeds", "",
              "A learned arm's policy run another way, its setting chosen on the development seeds "
              "before any test seed, then run on the test seeds: paired with the cell's best control "
-             "(every metric, as above) and with the arm it varies (variant − that arm)."]
+             "(every metric, as above), with its own control where it has one (its hand-made mechanisms "
+             "with the network's choice replaced by a fixed one: every metric, and that control against "
+             "the best control), and with the arm it varies (variant − that arm)."]
     for x in var:
         lines += ["", f"### {cell_title(x['cell'])}", ""]
         body = []
         for e in x["entries"]:
             lines.append(f"- `{e['arm']}`: {e['what']}")
-            for key, against in (("vs_best", e.get("vs_best", {}).get("control")), ("vs_base", e["base"])):
+            if "vs_own" in e:
+                lines.append(f"  - its own control `{e['vs_own']['control']}`: {e['vs_own']['control_what']}")
+            for key, against in (("vs_best", e.get("vs_best", {}).get("control")),
+                                 ("vs_own", e.get("vs_own", {}).get("control")), ("vs_base", e["base"])):
                 if key not in e:
                     continue
-                name = f"`{e['arm']}` vs `{against}`" + (" (best control)" if key == "vs_best" else "")
+                name = f"`{e['arm']}` vs `{against}`" + {"vs_best": " (best control)",
+                                                         "vs_own": " (its own control)"}.get(key, "")
                 body.append([name, "speed ratio − 1"] + diff_text(e[key]["ratio"], 2))
                 for c in e[key]["metrics"]:
                     if c["metric"] != SPEED:
                         body.append([name, SHORT[c["metric"]] + (" †" if c["fallback"] else "")]
                                     + diff_text(c, digits_of(c["metric"])))
-            if "vs_best" in e:
-                lines.append(f"  - reading against `{e['vs_best']['control']}`: "
-                             + reading_line(e["vs_best"]["ratio"], pct=True) + "; "
-                             + "; ".join(reading_line(c) for c in e["vs_best"]["metrics"] if c["metric"] != SPEED))
+            if "vs_own" in e and "vs_best" in e["vs_own"]:
+                c = e["vs_own"]["vs_best"]
+                body.append([f"`{e['vs_own']['control']}` vs `{c['control']}` (best control)", "speed ratio − 1"]
+                            + diff_text(c, 2))
+            for key in ("vs_best", "vs_own"):
+                if key in e:
+                    lines.append(f"  - reading against `{e[key]['control']}`: "
+                                 + reading_line(e[key]["ratio"], pct=True) + "; "
+                                 + "; ".join(reading_line(c) for c in e[key]["metrics"] if c["metric"] != SPEED))
         lines += [""] + md_table(PAIR_HEAD, body)
     return lines
 
@@ -1124,9 +1171,11 @@ def variants_csv(var):
     for x in var:
         d, pr = x["cell"]
         for e in x["entries"]:
-            for key in ("vs_best", "vs_base"):
+            for key in ("vs_best", "vs_own", "vs_base"):
                 if key in e:
                     rows += comparison_rows(d, pr, [e[key]["ratio"]] + e[key]["metrics"])
+            if "vs_own" in e and "vs_best" in e["vs_own"]:
+                rows += comparison_rows(d, pr, [e["vs_own"]["vs_best"]])
     return csv_text(COMPARISON_HEAD, rows)
 
 

@@ -315,6 +315,47 @@ class VariantTest(unittest.TestCase):
         self.assertFalse([l for l in lines if "outside the planned grid" in l and "palcas_margin" in l])
 
 
+    def test_a_variants_own_control_is_paired_with_it_and_with_the_best_control(self):
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings["variants"] = {"palcas_rules_on_top": {
+            "base": "palcas", "what": "palcas with a rule on top",
+            "own_control": {"arm": "rule_on_keep", "what": "the rule on top of KEEP"}}}
+        rows = fixture_rows()
+        low = [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]
+        for r in low:
+            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
+            # The control is faster than the variant by 1 m/s on every seed.
+            rows.append(dict(r, arm="rule_on_keep", point=r["point"].replace("palcas", "rule_on_keep"),
+                             **{SPEED: str(float(r[SPEED]) + 1.0)}))
+        a = trial_results.analyse(rows, settings, trial_results.load_registry())
+        e = trial_results.analyse_variants(rows, settings, a)[0]["entries"][0]
+        own = e["vs_own"]
+        self.assertEqual((own["ratio"]["learned"], own["ratio"]["control"]), ("palcas_rules_on_top", "rule_on_keep"))
+        self.assertEqual(trial_results.verdict(own["ratio"]), "loss", "the control is faster on every seed")
+        best = [x for x in a["cells"] if x["cell"] == LOW][0]["best"]
+        self.assertEqual((own["vs_best"]["learned"], own["vs_best"]["control"]), ("rule_on_keep", best))
+        page = "\n".join(trial_results.variants_section(trial_results.analyse_variants(rows, settings, a)))
+        self.assertIn("  - its own control `rule_on_keep`: the rule on top of KEEP", page)
+        self.assertIn("| `palcas_rules_on_top` vs `rule_on_keep` (its own control) | speed ratio − 1 |", page)
+        self.assertIn(f"| `rule_on_keep` vs `{best}` (best control) | speed ratio − 1 |", page)
+        self.assertIn("  - reading against `rule_on_keep`: ", page)
+        lines = trial_results.what_was_run(rows, [FIXTURE / "results.csv"], settings, FIXTURE, a)
+        self.assertIn("- Variants' own controls (their hand-made mechanisms without the network): "
+                      "3 rows of `rule_on_keep` (3 finished)", lines)
+        self.assertFalse([l for l in lines if "outside the planned grid" in l and "rule_on_keep" in l])
+        csv_text = trial_results.variants_csv(trial_results.analyse_variants(rows, settings, a))
+        self.assertIn(f",palcas_rules_on_top,rule_on_keep,{SPEED} ratio %,3,", csv_text)
+        self.assertIn(f",rule_on_keep,{best},{SPEED} ratio %,3,", csv_text)
+
+    def test_an_own_control_that_is_a_variant_or_says_nothing_is_refused(self):
+        settings = {"variants": {"a": {"base": "palcas", "own_control": {"arm": "a", "what": "x"}}}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'a' own_control 'a' is a variant"):
+            trial_results.own_controls(settings)
+        settings = {"variants": {"a": {"base": "palcas", "own_control": {"arm": "c"}}}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'a' own_control needs an arm and a what"):
+            trial_results.own_controls(settings)
+
+
 class TrainingsTest(unittest.TestCase):
     """trial.json's trainings: the shipped configuration trained from other seeds, each paired
     with the cell's best control and with the shipped training, and the spread between the
