@@ -588,8 +588,7 @@ def what_was_run(rows, files, settings, folder, a):
         lines.append(f"- Variants chosen on the development seeds: {len(var_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in var_rows}))
                      + f" ({sum(1 for r in var_rows if r['status'] == 'done')} finished)")
-    own_arms = {c["arm"] for c in own_controls(settings).values()}
-    own_rows = [r for r in rows if r["arm"] in own_arms]
+    own_rows = [r for r in rows if r["arm"] in own_control_arms(settings)]
     if own_rows:
         lines.append(f"- Variants' own controls (their hand-made mechanisms without the network): {len(own_rows)} rows of "
                      + ", ".join(f"`{x}`" for x in sorted({r['arm'] for r in own_rows}))
@@ -762,6 +761,10 @@ def own_controls(settings):
     return out
 
 
+def own_control_arms(settings):
+    return {c["arm"] for c in own_controls(settings).values()}
+
+
 def shipped_variants(settings):
     """{base arm: variant} of the variants trial.json marks `"ships": true`: the way the base
     arm's shipped policy now runs (its policy folder's rsu.yaml, say), so that the targets read
@@ -840,8 +843,7 @@ def alternative_arms(settings):
 def extra_arms(settings):
     """Arms shown in a section of their own, not in the planned grid."""
     retrained = (set(training_arms(settings)) | alternative_arms(settings)) - {training_reference(settings)}
-    own = {c["arm"] for c in own_controls(settings).values()}
-    return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained | own
+    return set(federation_arms(settings)) | set(variant_arms(settings)) | retrained | own_control_arms(settings)
 
 
 FEDERATION_METRICS = ["dsr", "lane_changes_per_cav", "throughput_vph", "total_time_spent_veh_h"]
