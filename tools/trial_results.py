@@ -17,8 +17,8 @@ than the trial's list). Sections of their own, each from its key: federation {re
 {arm: {base, what, ships, replaced_as, own_control}} (a learned arm's policy run another way; with ships
 true, the way the base arm's shipped policy now runs, which the targets and the federation table
 read in place of the base's own rows; the federation table keeps those under replaced_as;
-own_control {arm, what}: the rows of the variant's hand-made mechanisms without its network, a
-control of that variant, paired with it and with the best control),
+own_control {arm, what} or a list of them: the rows of the variant's hand-made mechanisms without
+its network, each a control of that variant, paired with it and with the best control),
 trainings {reference, arms: {arm: {seed, what}}, alternatives: {name: {what, arms, against}},
 configuration} (the shipped configuration trained from other seeds, or the one `configuration`
 names; another configuration trained from several seeds, compared training by training with
@@ -742,27 +742,35 @@ def variant_arms(settings):
 
 
 def own_controls(settings):
-    """{variant: {"arm": rows name, "what": text}} of the variants that name an `own_control`: the
-    variant's hand-made mechanisms run with its network's choice replaced by a fixed one, so that
-    every mechanism the variant gets that is not learned is in a control too. Its rows are a
+    """{variant: [{"arm": rows name, "what": text}, ...]} of the variants that name an
+    `own_control` (one {arm, what}, or a list of them): the variant's hand-made mechanisms run
+    with its network's choice replaced by a fixed one (KEEP, say, or a rule's advice), so that
+    every mechanism the variant gets that is not learned is in a control too. Their rows are a
     control of that variant only, not of the trial's cells."""
     variants = variant_arms(settings)
     out = {}
     for arm, v in variants.items():
-        own = v.get("own_control")
-        if own is None:
+        declared = v.get("own_control")
+        if declared is None:
             continue
-        name = (own.get("arm") or "").strip() if isinstance(own, dict) else ""
-        if not name or not (own.get("what") or "").strip():
-            raise TrialError(f"trial.json variants: '{arm}' own_control needs an arm and a what")
-        if name == arm or name in variants:
-            raise TrialError(f"trial.json variants: '{arm}' own_control '{name}' is a variant, not a control")
-        out[arm] = {"arm": name, "what": own["what"].strip()}
+        controls = []
+        for own in (declared if isinstance(declared, list) else [declared]):
+            name = (own.get("arm") or "").strip() if isinstance(own, dict) else ""
+            if not name or not (own.get("what") or "").strip():
+                raise TrialError(f"trial.json variants: '{arm}' own_control needs an arm and a what")
+            if name == arm or name in variants:
+                raise TrialError(f"trial.json variants: '{arm}' own_control '{name}' is a variant, not a control")
+            if name in [c["arm"] for c in controls]:
+                raise TrialError(f"trial.json variants: '{arm}' own_control '{name}' is named twice")
+            controls.append({"arm": name, "what": own["what"].strip()})
+        if not controls:
+            raise TrialError(f"trial.json variants: '{arm}' own_control is an empty list")
+        out[arm] = controls
     return out
 
 
 def own_control_arms(settings):
-    return {c["arm"] for c in own_controls(settings).values()}
+    return {c["arm"] for controls in own_controls(settings).values() for c in controls}
 
 
 def shipped_variants(settings):
@@ -902,10 +910,9 @@ def analyse_variants(rows, settings, a):
             e = {"arm": arm, "what": variants[arm].get("what", ""), "base": variants[arm].get("base", "")}
             if best.get(cell):
                 e["vs_best"] = dict(paired_entry(rows, cell, arm, best[cell], PAIRED, None), control=best[cell])
-            ctl = own.get(arm, {}).get("arm")
-            if ctl and done_rows(rows, ctl, cell):
-                e["vs_own"] = dict(paired_entry(rows, cell, arm, ctl, PAIRED, best.get(cell)), control=ctl,
-                                   control_what=own[arm]["what"])
+            e["vs_own"] = [dict(paired_entry(rows, cell, arm, c["arm"], PAIRED, best.get(cell)), control=c["arm"],
+                                control_what=c["what"])
+                           for c in own.get(arm, []) if done_rows(rows, c["arm"], cell)]
             if e["base"] and done_rows(rows, e["base"], cell):
                 e["vs_base"] = paired_entry(rows, cell, arm, e["base"], FEDERATION_METRICS, None)
             e["own"] = arm_cell(rows, arm, cell)
@@ -1142,28 +1149,26 @@ def variants_section(var):
         body = []
         for e in x["entries"]:
             lines.append(f"- `{e['arm']}`: {e['what']}")
-            if "vs_own" in e:
-                lines.append(f"  - its own control `{e['vs_own']['control']}`: {e['vs_own']['control_what']}")
-            for key, against in (("vs_best", e.get("vs_best", {}).get("control")),
-                                 ("vs_own", e.get("vs_own", {}).get("control")), ("vs_base", e["base"])):
-                if key not in e:
-                    continue
-                name = f"`{e['arm']}` vs `{against}`" + {"vs_best": " (best control)",
-                                                         "vs_own": " (its own control)"}.get(key, "")
-                body.append([name, "speed ratio − 1"] + diff_text(e[key]["ratio"], 2))
-                for c in e[key]["metrics"]:
+            for own in e["vs_own"]:
+                lines.append(f"  - its own control `{own['control']}`: {own['control_what']}")
+            read = ([(e["vs_best"], " (best control)")] if "vs_best" in e else []) \
+                + [(own, " (its own control)") for own in e["vs_own"]]
+            for entry, label in read + ([(dict(e["vs_base"], control=e["base"]), "")] if "vs_base" in e else []):
+                name = f"`{e['arm']}` vs `{entry['control']}`{label}"
+                body.append([name, "speed ratio − 1"] + diff_text(entry["ratio"], 2))
+                for c in entry["metrics"]:
                     if c["metric"] != SPEED:
                         body.append([name, SHORT[c["metric"]] + (" †" if c["fallback"] else "")]
                                     + diff_text(c, digits_of(c["metric"])))
-            if "vs_own" in e and "vs_best" in e["vs_own"]:
-                c = e["vs_own"]["vs_best"]
-                body.append([f"`{e['vs_own']['control']}` vs `{c['control']}` (best control)", "speed ratio − 1"]
-                            + diff_text(c, 2))
-            for key in ("vs_best", "vs_own"):
-                if key in e:
-                    lines.append(f"  - reading against `{e[key]['control']}`: "
-                                 + reading_line(e[key]["ratio"], pct=True) + "; "
-                                 + "; ".join(reading_line(c) for c in e[key]["metrics"] if c["metric"] != SPEED))
+            for own in e["vs_own"]:
+                if "vs_best" in own:
+                    c = own["vs_best"]
+                    body.append([f"`{own['control']}` vs `{c['control']}` (best control)", "speed ratio − 1"]
+                                + diff_text(c, 2))
+            for entry, _ in read:
+                lines.append(f"  - reading against `{entry['control']}`: "
+                             + reading_line(entry["ratio"], pct=True) + "; "
+                             + "; ".join(reading_line(c) for c in entry["metrics"] if c["metric"] != SPEED))
         lines += [""] + md_table(PAIR_HEAD, body)
     return lines
 
@@ -1173,11 +1178,11 @@ def variants_csv(var):
     for x in var:
         d, pr = x["cell"]
         for e in x["entries"]:
-            for key in ("vs_best", "vs_own", "vs_base"):
-                if key in e:
-                    rows += comparison_rows(d, pr, [e[key]["ratio"]] + e[key]["metrics"])
-            if "vs_own" in e and "vs_best" in e["vs_own"]:
-                rows += comparison_rows(d, pr, [e["vs_own"]["vs_best"]])
+            against = ([e["vs_best"]] if "vs_best" in e else []) + e["vs_own"] \
+                + ([e["vs_base"]] if "vs_base" in e else [])
+            for entry in against:
+                rows += comparison_rows(d, pr, [entry["ratio"]] + entry["metrics"])
+            rows += comparison_rows(d, pr, [own["vs_best"] for own in e["vs_own"] if "vs_best" in own])
     return csv_text(COMPARISON_HEAD, rows)
 
 

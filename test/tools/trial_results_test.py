@@ -329,7 +329,8 @@ class VariantTest(unittest.TestCase):
                              **{SPEED: str(float(r[SPEED]) + 1.0)}))
         a = trial_results.analyse(rows, settings, trial_results.load_registry())
         e = trial_results.analyse_variants(rows, settings, a)[0]["entries"][0]
-        own = e["vs_own"]
+        self.assertEqual(len(e["vs_own"]), 1)
+        own = e["vs_own"][0]
         self.assertEqual((own["ratio"]["learned"], own["ratio"]["control"]), ("palcas_rules_on_top", "rule_on_keep"))
         self.assertEqual(trial_results.verdict(own["ratio"]), "loss", "the control is faster on every seed")
         best = [x for x in a["cells"] if x["cell"] == LOW][0]["best"]
@@ -346,6 +347,51 @@ class VariantTest(unittest.TestCase):
         csv_text = trial_results.variants_csv(trial_results.analyse_variants(rows, settings, a))
         self.assertIn(f",palcas_rules_on_top,rule_on_keep,{SPEED} ratio %,3,", csv_text)
         self.assertIn(f",rule_on_keep,{best},{SPEED} ratio %,3,", csv_text)
+
+    def test_a_variant_with_two_own_controls_is_paired_with_each(self):
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings["variants"] = {"palcas_rules_on_top": {
+            "base": "palcas", "what": "palcas with a rule on top",
+            "own_control": [{"arm": "rule_on_keep", "what": "the rule on top of KEEP"},
+                            {"arm": "rule_on_rule", "what": "the rule on top of the rule"}]}}
+        rows = fixture_rows()
+        low = [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]
+        for r in low:
+            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
+            # KEEP slower than the variant by 1 m/s on every seed, the rule faster by 1 m/s.
+            rows.append(dict(r, arm="rule_on_keep", point=r["point"].replace("palcas", "rule_on_keep"),
+                             **{SPEED: str(float(r[SPEED]) - 1.0)}))
+            rows.append(dict(r, arm="rule_on_rule", point=r["point"].replace("palcas", "rule_on_rule"),
+                             **{SPEED: str(float(r[SPEED]) + 1.0)}))
+        self.assertEqual(trial_results.own_control_arms(settings), {"rule_on_keep", "rule_on_rule"})
+        a = trial_results.analyse(rows, settings, trial_results.load_registry())
+        var = trial_results.analyse_variants(rows, settings, a)
+        e = var[0]["entries"][0]
+        self.assertEqual([o["control"] for o in e["vs_own"]], ["rule_on_keep", "rule_on_rule"])
+        self.assertEqual([trial_results.verdict(o["ratio"]) for o in e["vs_own"]], ["gain", "loss"])
+        page = "\n".join(trial_results.variants_section(var))
+        for name in ("rule_on_keep", "rule_on_rule"):
+            self.assertIn(f"| `palcas_rules_on_top` vs `{name}` (its own control) | speed ratio − 1 |", page)
+            self.assertIn(f"  - reading against `{name}`: ", page)
+        self.assertIn("  - its own control `rule_on_rule`: the rule on top of the rule", page)
+        csv_text = trial_results.variants_csv(var)
+        self.assertIn(f",palcas_rules_on_top,rule_on_rule,{SPEED} ratio %,3,", csv_text)
+        lines = trial_results.what_was_run(rows, [FIXTURE / "results.csv"], settings, FIXTURE, a)
+        self.assertIn("- Variants' own controls (their hand-made mechanisms without the network): "
+                      "6 rows of `rule_on_keep`, `rule_on_rule` (6 finished)", lines)
+        self.assertFalse([l for l in lines if "outside the planned grid" in l and "rule_on_rule" in l])
+
+    def test_an_own_control_named_twice_or_an_empty_list_is_refused(self):
+        twice = {"arm": "c", "what": "x"}
+        settings = {"variants": {"a": {"base": "palcas", "own_control": [twice, dict(twice)]}}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'a' own_control 'c' is named twice"):
+            trial_results.own_controls(settings)
+        settings = {"variants": {"a": {"base": "palcas", "own_control": []}}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'a' own_control is an empty list"):
+            trial_results.own_controls(settings)
+        settings = {"variants": {"a": {"base": "palcas", "own_control": [twice, {"arm": "a", "what": "y"}]}}}
+        with self.assertRaisesRegex(trial_results.TrialError, "'a' own_control 'a' is a variant"):
+            trial_results.own_controls(settings)
 
     def test_an_own_control_that_is_a_variant_or_says_nothing_is_refused(self):
         settings = {"variants": {"a": {"base": "palcas", "own_control": {"arm": "a", "what": "x"}}}}
