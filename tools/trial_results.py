@@ -893,6 +893,30 @@ def paired_entry(rows, cell, left, right, metrics, best):
     return e
 
 
+# The columns two arms' rows must agree on, seed by seed, to be the same runs (same_rows_as).
+SAME_RUN_COLUMNS = ["efficiency_all_mps", "throughput_vph", "unserved_vehicles", "total_time_spent_veh_h",
+                    "dsr_pct", "dsr_censored_pct", "comfort_share_pct", "lane_changes_per_cav", "collisions"]
+
+
+def same_rows_as(rows, arm, cell, others):
+    """The arms of `others` whose finished rows in the cell equal `arm`'s on every seed `arm` ran
+    and every SAME_RUN_COLUMNS column: an own control that turns out to be a trial arm already
+    (its hand-made mechanisms changed nothing when the fixed choice chose), so the page says so."""
+    mine = {r["seed"]: r for r in done_rows(rows, arm, cell)}
+
+    def equal(x, y):
+        a, b = number(x), number(y)
+        return a == b or (a is not None and b is not None and abs(a - b) <= 1e-9 * max(1.0, abs(a)))
+
+    out = []
+    for other in others:
+        theirs = {r["seed"]: r for r in done_rows(rows, other, cell)}
+        if mine and set(mine) <= set(theirs) and all(
+                equal(mine[s].get(c), theirs[s].get(c)) for s in mine for c in SAME_RUN_COLUMNS):
+            out.append(other)
+    return out
+
+
 def analyse_variants(rows, settings, a):
     """Each variant against the cell's best control (every paired metric), against its own
     control where it names one (every paired metric; and that control against the best control
@@ -911,7 +935,8 @@ def analyse_variants(rows, settings, a):
             if best.get(cell):
                 e["vs_best"] = dict(paired_entry(rows, cell, arm, best[cell], PAIRED, None), control=best[cell])
             e["vs_own"] = [dict(paired_entry(rows, cell, arm, c["arm"], PAIRED, best.get(cell)), control=c["arm"],
-                                control_what=c["what"])
+                                control_what=c["what"], same_as=same_rows_as(rows, c["arm"], cell, a["controls"]),
+                                seeds=len(done_rows(rows, c["arm"], cell)))
                            for c in own.get(arm, []) if done_rows(rows, c["arm"], cell)]
             if e["base"] and done_rows(rows, e["base"], cell):
                 e["vs_base"] = paired_entry(rows, cell, arm, e["base"], FEDERATION_METRICS, None)
@@ -1151,6 +1176,10 @@ def variants_section(var):
             lines.append(f"- `{e['arm']}`: {e['what']}")
             for own in e["vs_own"]:
                 lines.append(f"  - its own control `{own['control']}`: {own['control_what']}")
+                for same in own["same_as"]:
+                    lines.append(f"    - here its {own['seeds']} rows equal `{same}`'s seed for seed on every "
+                                 f"metric: the mechanisms changed nothing, so the trial's `{same}` arm is this "
+                                 "control already")
             read = ([(e["vs_best"], " (best control)")] if "vs_best" in e else []) \
                 + [(own, " (its own control)") for own in e["vs_own"]]
             for entry, label in read + ([(dict(e["vs_base"], control=e["base"]), "")] if "vs_base" in e else []):

@@ -381,6 +381,26 @@ class VariantTest(unittest.TestCase):
                       "6 rows of `rule_on_keep`, `rule_on_rule` (6 finished)", lines)
         self.assertFalse([l for l in lines if "outside the planned grid" in l and "rule_on_rule" in l])
 
+    def test_an_own_control_whose_rows_equal_a_trial_arm_is_named_as_that_arm(self):
+        settings = json.loads((FIXTURE / "trial.json").read_text())
+        settings["variants"] = {"palcas_rules_on_top": {
+            "base": "palcas", "what": "palcas with a rule on top",
+            "own_control": {"arm": "rule_on_keep", "what": "the rule on top of KEEP"}}}
+        rows = fixture_rows()
+        for r in [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
+            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
+        keep = [r for r in rows if r["arm"] == "keep" and (r["demand"], r["pr"]) == LOW]
+        copies = [dict(r, arm="rule_on_keep", point=r["point"].replace("keep", "rule_on_keep")) for r in keep]
+        a = trial_results.analyse(rows + copies, settings, trial_results.load_registry())
+        own = trial_results.analyse_variants(rows + copies, settings, a)[0]["entries"][0]["vs_own"][0]
+        self.assertEqual(own["same_as"], ["keep"])
+        page = "\n".join(trial_results.variants_section(trial_results.analyse_variants(rows + copies, settings, a)))
+        self.assertIn(f"    - here its {len(keep)} rows equal `keep`'s seed for seed on every metric", page)
+        # One seed's lane changes differ: not the same runs.
+        copies[-1] = dict(copies[-1], lane_changes_per_cav=str(float(copies[-1]["lane_changes_per_cav"]) + 0.01))
+        own = trial_results.analyse_variants(rows + copies, settings, a)[0]["entries"][0]["vs_own"][0]
+        self.assertEqual(own["same_as"], [])
+
     def test_an_own_control_named_twice_or_an_empty_list_is_refused(self):
         twice = {"arm": "c", "what": "x"}
         settings = {"variants": {"a": {"base": "palcas", "own_control": [twice, dict(twice)]}}}
