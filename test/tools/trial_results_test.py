@@ -315,18 +315,27 @@ class VariantTest(unittest.TestCase):
         self.assertFalse([l for l in lines if "outside the planned grid" in l and "palcas_margin" in l])
 
 
-    def test_a_variants_own_control_is_paired_with_it_and_with_the_best_control(self):
+    @staticmethod
+    def rules_on_top(own_control):
+        """The fixture's settings with one variant, palcas_rules_on_top, naming `own_control`."""
         settings = json.loads((FIXTURE / "trial.json").read_text())
         settings["variants"] = {"palcas_rules_on_top": {
-            "base": "palcas", "what": "palcas with a rule on top",
-            "own_control": {"arm": "rule_on_keep", "what": "the rule on top of KEEP"}}}
+            "base": "palcas", "what": "palcas with a rule on top", "own_control": own_control}}
+        return settings
+
+    @staticmethod
+    def low_copies(rows, arm, name, speed_delta=0.0):
+        """`arm`'s rows of the LOW cell under another name, their speed moved by speed_delta m/s."""
+        moved = lambda r: {SPEED: str(float(r[SPEED]) + speed_delta)} if speed_delta else {}
+        return [dict(r, arm=name, point=r["point"].replace(arm, name), **moved(r))
+                for r in rows if r["arm"] == arm and (r["demand"], r["pr"]) == LOW]
+
+    def test_a_variants_own_control_is_paired_with_it_and_with_the_best_control(self):
+        settings = self.rules_on_top({"arm": "rule_on_keep", "what": "the rule on top of KEEP"})
         rows = fixture_rows()
-        low = [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]
-        for r in low:
-            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
-            # The control is faster than the variant by 1 m/s on every seed.
-            rows.append(dict(r, arm="rule_on_keep", point=r["point"].replace("palcas", "rule_on_keep"),
-                             **{SPEED: str(float(r[SPEED]) + 1.0)}))
+        # The control is faster than the variant by 1 m/s on every seed.
+        rows += self.low_copies(rows, "palcas", "palcas_rules_on_top") \
+            + self.low_copies(rows, "palcas", "rule_on_keep", speed_delta=1.0)
         a = trial_results.analyse(rows, settings, trial_results.load_registry())
         e = trial_results.analyse_variants(rows, settings, a)[0]["entries"][0]
         self.assertEqual(len(e["vs_own"]), 1)
@@ -349,20 +358,13 @@ class VariantTest(unittest.TestCase):
         self.assertIn(f",rule_on_keep,{best},{SPEED} ratio %,3,", csv_text)
 
     def test_a_variant_with_two_own_controls_is_paired_with_each(self):
-        settings = json.loads((FIXTURE / "trial.json").read_text())
-        settings["variants"] = {"palcas_rules_on_top": {
-            "base": "palcas", "what": "palcas with a rule on top",
-            "own_control": [{"arm": "rule_on_keep", "what": "the rule on top of KEEP"},
-                            {"arm": "rule_on_rule", "what": "the rule on top of the rule"}]}}
+        settings = self.rules_on_top([{"arm": "rule_on_keep", "what": "the rule on top of KEEP"},
+                                      {"arm": "rule_on_rule", "what": "the rule on top of the rule"}])
         rows = fixture_rows()
-        low = [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]
-        for r in low:
-            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
-            # KEEP slower than the variant by 1 m/s on every seed, the rule faster by 1 m/s.
-            rows.append(dict(r, arm="rule_on_keep", point=r["point"].replace("palcas", "rule_on_keep"),
-                             **{SPEED: str(float(r[SPEED]) - 1.0)}))
-            rows.append(dict(r, arm="rule_on_rule", point=r["point"].replace("palcas", "rule_on_rule"),
-                             **{SPEED: str(float(r[SPEED]) + 1.0)}))
+        # KEEP slower than the variant by 1 m/s on every seed, the rule faster by 1 m/s.
+        rows += self.low_copies(rows, "palcas", "palcas_rules_on_top") \
+            + self.low_copies(rows, "palcas", "rule_on_keep", speed_delta=-1.0) \
+            + self.low_copies(rows, "palcas", "rule_on_rule", speed_delta=1.0)
         self.assertEqual(trial_results.own_control_arms(settings), {"rule_on_keep", "rule_on_rule"})
         a = trial_results.analyse(rows, settings, trial_results.load_registry())
         var = trial_results.analyse_variants(rows, settings, a)
@@ -382,15 +384,11 @@ class VariantTest(unittest.TestCase):
         self.assertFalse([l for l in lines if "outside the planned grid" in l and "rule_on_rule" in l])
 
     def test_an_own_control_whose_rows_equal_a_trial_arm_is_named_as_that_arm(self):
-        settings = json.loads((FIXTURE / "trial.json").read_text())
-        settings["variants"] = {"palcas_rules_on_top": {
-            "base": "palcas", "what": "palcas with a rule on top",
-            "own_control": {"arm": "rule_on_keep", "what": "the rule on top of KEEP"}}}
+        settings = self.rules_on_top({"arm": "rule_on_keep", "what": "the rule on top of KEEP"})
         rows = fixture_rows()
-        for r in [r for r in rows if r["arm"] == "palcas" and (r["demand"], r["pr"]) == LOW]:
-            rows.append(dict(r, arm="palcas_rules_on_top", point=r["point"].replace("palcas", "palcas_rules_on_top")))
+        rows += self.low_copies(rows, "palcas", "palcas_rules_on_top")
         keep = [r for r in rows if r["arm"] == "keep" and (r["demand"], r["pr"]) == LOW]
-        copies = [dict(r, arm="rule_on_keep", point=r["point"].replace("keep", "rule_on_keep")) for r in keep]
+        copies = self.low_copies(rows, "keep", "rule_on_keep")
         a = trial_results.analyse(rows + copies, settings, trial_results.load_registry())
         own = trial_results.analyse_variants(rows + copies, settings, a)[0]["entries"][0]["vs_own"][0]
         self.assertEqual(own["same_as"], ["keep"])
